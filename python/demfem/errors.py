@@ -1,0 +1,71 @@
+"""The demfem exception tree.
+
+One root, :class:`DemfemError`. Bad input raises :class:`InvalidParameterError`, which is also a
+``ValueError``, with a message that names the field, the value and the allowed range. The same
+classes are raised by the Rust core (they are defined in ``demfem._core``) and by the Python
+modules, so ``except demfem.errors.InvalidParameterError`` catches both.
+"""
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from demfem._core import (
+    DemfemError,
+    DemfemIOError,
+    EffectError,
+    InvalidParameterError,
+    NumericalError,
+    ShapeError,
+    SimulationInterrupted,
+    UnstableTimeStepError,
+)
+
+__all__ = [
+    "DemfemError",
+    "DemfemIOError",
+    "EffectError",
+    "InvalidParameterError",
+    "NumericalError",
+    "ShapeError",
+    "SimulationInterrupted",
+    "UnstableTimeStepError",
+    "check_range",
+    "check_positive",
+]
+
+
+def _as_float(field: str, value: Any) -> float:
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise InvalidParameterError(f"invalid {field} = {value!r}: must be a real number") from None
+    return x
+
+
+def check_range(
+    field: str,
+    value: Any,
+    lo: float = -math.inf,
+    hi: float = math.inf,
+    *,
+    lo_open: bool = True,
+    hi_open: bool = True,
+) -> float:
+    """Return ``value`` as a float if it is finite and inside the interval, else raise
+    :class:`InvalidParameterError` naming ``field``, the value and the allowed range."""
+    x = _as_float(field, value)
+    lo_ok = x > lo if lo_open else x >= lo
+    hi_ok = x < hi if hi_open else x <= hi
+    if not (math.isfinite(x) and lo_ok and hi_ok):
+        left = "(" if lo_open else "["
+        right = ")" if hi_open else "]"
+        raise InvalidParameterError(
+            f"invalid {field} = {value!r}: must be finite and in {left}{lo:g}, {hi:g}{right}"
+        )
+    return x
+
+
+def check_positive(field: str, value: Any) -> float:
+    """``value`` as a float if finite and > 0, else :class:`InvalidParameterError`."""
+    return check_range(field, value, 0.0, math.inf)

@@ -1,0 +1,2 @@
+//! Discrete element method: particles (structure of arrays), contact laws, neighbour
+//! search, integrator, effects, recorder and checkpoint.
