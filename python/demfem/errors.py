@@ -2,24 +2,49 @@
 
 One root, :class:`DemfemError`. Bad input raises :class:`InvalidParameterError`, which is also a
 ``ValueError``, with a message that names the field, the value and the allowed range. The same
-classes are raised by the Rust core (they are defined in ``demfem._core``) and by the Python
-modules, so ``except demfem.errors.InvalidParameterError`` catches both.
+classes are raised by the Rust core (the bindings raise the classes defined here) and by the
+Python modules, so ``except demfem.errors.InvalidParameterError`` catches both.
 """
 from __future__ import annotations
 
 import math
 from typing import Any
 
-from demfem._core import (
-    DemfemError,
-    DemfemIOError,
-    EffectError,
-    InvalidParameterError,
-    NumericalError,
-    ShapeError,
-    SimulationInterrupted,
-    UnstableTimeStepError,
-)
+
+
+class DemfemError(Exception):
+    """Base class of every demfem error."""
+
+
+class InvalidParameterError(DemfemError, ValueError):
+    """A value outside its allowed range, NaN or infinite; the message names the field,
+    the value and the allowed range."""
+
+
+class UnstableTimeStepError(InvalidParameterError):
+    """A requested time step above the stable limit of the active laws or elements."""
+
+
+class ShapeError(DemfemError, ValueError):
+    """Arrays whose shapes or lengths do not fit together."""
+
+
+class EffectError(DemfemError, ValueError):
+    """A scene needs an effect it did not name (or names one it cannot use)."""
+
+
+class NumericalError(DemfemError, RuntimeError):
+    """A simulation produced a non-finite value or lost stability."""
+
+
+class DemfemIOError(DemfemError, OSError):
+    """Reading or writing a file failed."""
+
+
+class SimulationInterrupted(DemfemError, KeyboardInterrupt):
+    """A run stopped cleanly at a step boundary (Ctrl-C); its state is consistent and can be
+    checkpointed or continued."""
+
 
 __all__ = [
     "DemfemError",

@@ -2,23 +2,16 @@
 //! the mapping of [`demfem::DemfemError`] onto one Python exception tree. No physics here.
 
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
-use pyo3::create_exception;
-use pyo3::exceptions::{PyException, PyValueError};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use pyo3::types::PyType;
 
 use demfem::contact::{self, ForceClamp, NormalLaw};
 use demfem::DemfemError;
 
-create_exception!(_core, DemfemErrorPy, PyException, "Base class of every demfem error.");
-create_exception!(_core, InvalidParameterError, PyValueError, "A value outside its allowed range (also a ValueError).");
-create_exception!(_core, UnstableTimeStepError, PyValueError, "A time step above the stable limit (also a ValueError).");
-create_exception!(_core, ShapeError, PyValueError, "Arrays whose shapes do not fit together (also a ValueError).");
-create_exception!(_core, EffectError, PyValueError, "A scene needs an effect it did not name (also a ValueError).");
-create_exception!(_core, NumericalError, PyException, "The simulation produced a non-finite value.");
-create_exception!(_core, DemfemIOError, PyException, "Reading or writing a file failed.");
-create_exception!(_core, SimulationInterrupted, PyException, "A run stopped cleanly at a step boundary (Ctrl-C).");
-
-/// The one conversion from core errors to Python exceptions.
+/// The one conversion from core errors to Python exceptions: each variant raises the class
+/// of the same name from `demfem.errors` (pure Python, so that bad input is both a
+/// `DemfemError` and a `ValueError`).
 pub(crate) struct PyDemfemError(DemfemError);
 
 impl From<DemfemError> for PyDemfemError {
@@ -29,16 +22,26 @@ impl From<DemfemError> for PyDemfemError {
 
 impl From<PyDemfemError> for PyErr {
     fn from(e: PyDemfemError) -> PyErr {
+        let class = match e.0 {
+            DemfemError::InvalidParameter { .. } => "InvalidParameterError",
+            DemfemError::UnstableTimeStep { .. } => "UnstableTimeStepError",
+            DemfemError::ShapeMismatch { .. } => "ShapeError",
+            DemfemError::Effect(_) => "EffectError",
+            DemfemError::Numerical(_) => "NumericalError",
+            DemfemError::Io { .. } => "DemfemIOError",
+            DemfemError::Interrupted { .. } => "SimulationInterrupted",
+        };
         let msg = e.0.to_string();
-        match e.0 {
-            DemfemError::InvalidParameter { .. } => InvalidParameterError::new_err(msg),
-            DemfemError::UnstableTimeStep { .. } => UnstableTimeStepError::new_err(msg),
-            DemfemError::ShapeMismatch { .. } => ShapeError::new_err(msg),
-            DemfemError::Effect(_) => EffectError::new_err(msg),
-            DemfemError::Numerical(_) => NumericalError::new_err(msg),
-            DemfemError::Io { .. } => DemfemIOError::new_err(msg),
-            DemfemError::Interrupted { .. } => SimulationInterrupted::new_err(msg),
-        }
+        Python::attach(|py| {
+            let cls = py
+                .import("demfem.errors")
+                .and_then(|m| m.getattr(class))
+                .and_then(|c| c.cast_into::<PyType>().map_err(PyErr::from));
+            match cls {
+                Ok(cls) => PyErr::from_type(cls, msg),
+                Err(_) => PyValueError::new_err(msg),
+            }
+        })
     }
 }
 
@@ -143,16 +146,7 @@ fn hertz_contact_duration(k_h: f64, m_star: f64, v_rel: f64) -> PyResult<f64> {
 
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    let py = m.py();
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
-    m.add("DemfemError", py.get_type::<DemfemErrorPy>())?;
-    m.add("InvalidParameterError", py.get_type::<InvalidParameterError>())?;
-    m.add("UnstableTimeStepError", py.get_type::<UnstableTimeStepError>())?;
-    m.add("ShapeError", py.get_type::<ShapeError>())?;
-    m.add("EffectError", py.get_type::<EffectError>())?;
-    m.add("NumericalError", py.get_type::<NumericalError>())?;
-    m.add("DemfemIOError", py.get_type::<DemfemIOError>())?;
-    m.add("SimulationInterrupted", py.get_type::<SimulationInterrupted>())?;
     m.add_function(wrap_pyfunction!(normal_force, m)?)?;
     m.add_function(wrap_pyfunction!(max_impact_force, m)?)?;
     m.add_function(wrap_pyfunction!(tsuji_restitution, m)?)?;

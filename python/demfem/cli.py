@@ -1,0 +1,70 @@
+"""Command line: ``demfem <command>``. Run ``demfem --help`` for the list."""
+from __future__ import annotations
+
+import argparse
+import sys
+from typing import Optional, Sequence
+
+import numpy as np
+
+from demfem.errors import DemfemError
+
+__all__ = ["main"]
+
+
+def _cmd_calibrate(args: argparse.Namespace) -> int:
+    from demfem.calibration import force_vs_modulus, write_calibration
+    from demfem.cartridge import Cartridge
+    from demfem.contact import ContactBody, hertz_contact_duration, rayleigh_time_step
+
+    cart = Cartridge()
+    sphere = cart.equivalent_sphere()
+    body = ContactBody.from_cartridge(cart)
+    mp = cart.mass_properties()
+    print("Default cartridge (3 mL, ISO 13926-1 style), glass:", cart.material.name)
+    print(f"  glass volume        {cart.glass_volume * 1e9:10.1f} mm^3")
+    print(f"  mass                {cart.mass * 1e3:10.3f} g")
+    print(f"  centre of mass z    {mp.center_of_mass[2] * 1e3:10.2f} mm from the open end")
+    print(f"  inertia (Ixx, Izz)  {mp.inertia[0, 0]:10.3e} {mp.inertia[2, 2]:10.3e} kg m^2")
+    print(f"  equivalent sphere   {sphere.diameter * 1e3:10.2f} mm diameter")
+    print(f"  Reissner k_R        {body.k_reissner:10.3e} N/m (t = {cart.wall_thickness*1e3:g} mm,"
+          f" R = {cart.body_mid_radius*1e3:g} mm)")
+    print(f"  Hertz contact time  {hertz_contact_duration(body, body, args.v_rel)*1e6:10.2f} us"
+          f" at {args.v_rel:g} m/s")
+    print(f"  Rayleigh time step  {rayleigh_time_step(sphere.radius, cart.material.E, cart.material.nu, cart.material.density)*1e6:10.3f} us")
+    E = np.logspace(np.log10(args.e_min), np.log10(args.e_max), args.n)
+    table = force_vs_modulus(cart, E, args.v_rel)
+    print(f"\nMaximum contact force, two cartridges at v_rel = {args.v_rel:g} m/s (Fig. 3 analogue):")
+    print(table.format())
+    csv, png = write_calibration(args.out, table)
+    print(f"\nwrote {csv}\nwrote {png}")
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of the ``demfem`` command."""
+    p = argparse.ArgumentParser(prog="demfem", description="DEM-FEM breakage of glass cartridges "
+                                "on a conveyor-belt accumulation table (SI units).")
+    sub = p.add_subparsers(dest="command", required=True)
+    c = sub.add_parser("calibrate", help="equivalent sphere and Fig. 3: max force vs E per law")
+    c.add_argument("--v-rel", type=float, default=0.2, help="relative impact speed, m/s (0.2)")
+    c.add_argument("--e-min", type=float, default=1e7, help="smallest Young's modulus, Pa (1e7)")
+    c.add_argument("--e-max", type=float, default=1e11, help="largest Young's modulus, Pa (1e11)")
+    c.add_argument("--n", type=int, default=9, help="number of moduli, log-spaced (9)")
+    c.add_argument("--out", default="demfem_out", help="output directory (demfem_out)")
+    c.set_defaults(func=_cmd_calibrate)
+    return p
+
+
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    """Entry point of the ``demfem`` command; returns the exit code."""
+    args = build_parser().parse_args(argv)
+    try:
+        return int(args.func(args))
+    except (DemfemError, ValueError) as exc:
+        print(f"demfem {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())
