@@ -148,26 +148,23 @@ pub fn hertz_reissner_force(overlap: f64, k_h: f64, k_r: f64) -> f64 {
         return 0.0;
     }
     let kh23 = (k_h * k_h).cbrt();
+    let (inv_kr, inv_kh23) = (1.0 / k_r, 1.0 / kh23);
     let x_h = kh23.sqrt() * overlap.sqrt(); // (k_H δ^{3/2})^{1/3}
     let x_r = (k_r * overlap).cbrt();
     let mut x = x_h.min(x_r);
-    for _ in 0..100 {
-        let g = x * x * x / k_r + x * x / kh23 - overlap;
-        let dg = 3.0 * x * x / k_r + 2.0 * x / kh23;
-        if dg <= 0.0 {
+    // Newton from above decreases x monotonically; stop when round-off ends the descent.
+    for _ in 0..64 {
+        let g = (x * inv_kr + inv_kh23) * x * x - overlap;
+        let dg = (3.0 * x * inv_kr + 2.0 * inv_kh23) * x;
+        let next = x - g / dg;
+        if !(next < x) || !(next > 0.0) {
             break;
         }
-        let step = g / dg;
-        let next = x - step;
-        if !(next > 0.0) {
-            x *= 0.5;
-            continue;
-        }
-        if step.abs() <= 4.0 * f64::EPSILON * x {
-            x = next;
-            break;
-        }
+        let done = x - next <= 1e-15 * x;
         x = next;
+        if done {
+            break;
+        }
     }
     x * x * x
 }
