@@ -108,3 +108,21 @@ def write_calibration(out_dir: "str | Path", table: CalibrationTable) -> tuple[P
     csv = atomic_write_text(out_dir / "calibration.csv", table.to_csv())
     png = plot_force_vs_modulus(table, out_dir / "calibration_force_vs_E.png")
     return csv, png
+
+
+def sweep_point(params: dict) -> dict:
+    """Sweep runner (``demfem sweep --runner demfem.calibration:sweep_point``): maximum force
+    (N) of two default cartridges for ``params`` with ``E`` (Pa, default 45e9) and ``v_rel``
+    (m/s, default 0.2), for every model."""
+    from demfem.cartridge import Cartridge
+
+    unknown = set(params) - {"E", "v_rel"}
+    if unknown:
+        from demfem.errors import InvalidParameterError
+
+        raise InvalidParameterError(
+            f"invalid sweep parameter(s) {sorted(unknown)}: allowed are ['E', 'v_rel']")
+    c = Cartridge()
+    table = force_vs_modulus(c, [float(params.get("E", c.material.E))],
+                             float(params.get("v_rel", 0.2)))
+    return {f"F_{m}_N": float(table.forces[i, 0]) for i, m in enumerate(table.models)}

@@ -41,6 +41,21 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_sweep(args: argparse.Namespace) -> int:
+    from demfem.sweep import parse_grid_option, sweep
+
+    grid = parse_grid_option(args.grid)
+
+    def progress(done: int, total: int) -> None:
+        print(f"\r  runs finished: {done}/{total}", end="", flush=True)
+
+    res = sweep(grid, args.runner, args.out, scheduler=args.scheduler, n_workers=args.workers,
+                progress=progress)
+    print(f"\nran {res.ran}, skipped {res.skipped} already finished; table: {res.table_path}")
+    print(res.table_path.read_text(), end="")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``demfem`` command."""
     p = argparse.ArgumentParser(prog="demfem", description="DEM-FEM breakage of glass cartridges "
@@ -53,6 +68,17 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--n", type=int, default=9, help="number of moduli, log-spaced (9)")
     c.add_argument("--out", default="demfem_out", help="output directory (demfem_out)")
     c.set_defaults(func=_cmd_calibrate)
+    s = sub.add_parser("sweep", help="run a parameter grid on Dask (LocalCluster by default)")
+    s.add_argument("--runner", required=True,
+                   help="'module:function' run per point, e.g. demfem.calibration:sweep_point")
+    s.add_argument("--grid", action="append", required=True, metavar="NAME=v1,v2,...",
+                   help="one parameter and its values; repeat for more (Cartesian product)")
+    s.add_argument("--out", default="demfem_out/sweep", help="output directory")
+    s.add_argument("--scheduler", default=None,
+                   help="Dask scheduler address (tcp://host:8786), or 'serial'; "
+                        "default: a LocalCluster on this machine")
+    s.add_argument("--workers", type=int, default=None, help="LocalCluster worker processes")
+    s.set_defaults(func=_cmd_sweep)
     return p
 
 
