@@ -337,7 +337,14 @@ class AccumulationTable:
                 if _is_bool(value):
                     raise InvalidParameterError(
                         f"invalid {f.name} = {value!r}: must be a real number")
-                object.__setattr__(self, f.name, check_range(f.name, value))
+                try:
+                    number = float(value)
+                except (TypeError, ValueError):
+                    raise InvalidParameterError(
+                        f"invalid {f.name} = {value!r}: must be a real number") from None
+                # Finiteness and range are checked field by field in _validate, whose
+                # messages give each field's own allowed range.
+                object.__setattr__(self, f.name, number)
         self._validate()
 
     def _validate(self) -> None:
@@ -662,7 +669,9 @@ class AccumulationTable:
 
     def toml_text(self) -> str:
         """The TOML text that :meth:`from_toml` reads back to an equal table."""
-        lines = ["# demfem accumulation-table scene (SI units: m, kg, s, Pa; angle in degrees)",
+        lines = ["# demfem accumulation-table scene (SI units: m, kg, s, Pa; angle in degrees).",
+                 "# Geometry, gate law and tag rules: the docstring of demfem.scenes.table.",
+                 "# Missing keys take their defaults; unknown keys are errors.",
                  f'scene = "{SCENE_NAME}"']
         for f in dataclasses.fields(self):
             value = getattr(self, f.name)
@@ -670,10 +679,42 @@ class AccumulationTable:
                 text = "true" if value else "false"
             elif isinstance(value, int):
                 text = str(value)
+            elif value != 0 and not 1e-4 <= abs(value) < 1e5:
+                # Shortest round-trip form, readable for moduli: 4.5e+10, not 45000000000.0.
+                text = np.format_float_scientific(value, unique=True, trim="0")
             else:
                 text = repr(float(value))
-            lines.append(f"{f.name} = {text}")
+            unit = _UNITS.get(f.name, "")
+            lines.append(f"{f.name} = {text}" + (f"  # {unit}" if unit else ""))
         return "\n".join(lines) + "\n"
+
+
+#: Units of the fields, written as comments into scene files.
+_UNITS: dict[str, str] = {
+    "n_spheres": "spheres at t = 0",
+    "sphere_radius": "m",
+    "sphere_mass": "kg",
+    "length": "m, rectangular section along the belt (x)",
+    "width": "m, across the belt (y)",
+    "tilted_wall_length": "m",
+    "tilted_wall_angle_deg": "degrees below the belt direction, in (0, 90)",
+    "wall_height": "m",
+    "opening_width": "m, mean opening w0",
+    "gate_amplitude": "m, A in w(t) = w0 + A sin(2 pi t / T + phase)",
+    "gate_period": "s, T",
+    "gate_phase": "rad",
+    "belt_velocity": "m/s along +x",
+    "gravity": "m/s^2 along -z",
+    "young_modulus": "Pa",
+    "poisson_ratio": "-",
+    "density": "kg/m^3",
+    "friction": "Coulomb coefficient, sphere-sphere and sphere-wall",
+    "restitution": "normal coefficient of restitution",
+    "rolling_resistance": "coefficient; > 0 adds the effect rolling_resistance",
+    "planar": "keep centres in one layer (effect planar)",
+    "refeed": "re-insert removed spheres upstream",
+    "packing_gap": "gap between start neighbours, fraction of the diameter",
+}
 
 
 def _explained(check, name: str, value: Any, *args: Any, why: str, **kwargs: Any) -> float:
