@@ -166,7 +166,7 @@ def rank_setups(times: Sequence[np.ndarray], forces: Sequence[np.ndarray],
     if not (len(times) == len(forces) == len(labels)) or len(labels) == 0:
         raise ShapeError(f"shape mismatch: {len(times)} times, {len(forces)} forces and "
                          f"{len(labels)} labels; expected the same number (> 0) of each")
-    stats = []
+    rows = []
     for k, (t, f, label) in enumerate(zip(times, forces, labels)):
         t, f = np.asarray(t, float), np.asarray(f, float)
         if t.shape != f.shape or t.ndim != 1:
@@ -177,8 +177,8 @@ def rank_setups(times: Sequence[np.ndarray], forces: Sequence[np.ndarray],
             raise InvalidParameterError(f"invalid forces[{k}] ({label!r}): no finite value "
                                         f"at t >= discard_before = {discard_before:g} s")
         st = force_statistics(f[keep], quantile)
-        stats.append((st["mean"], st["peak"], st["quantile"]))
-    stats = np.array(stats)
+        rows.append((st["mean"], st["peak"], st["quantile"]))
+    stats = np.array(rows)
     score = gentleness_score(stats, weights)
     order = np.argsort(score, kind="stable")
     table = np.zeros(len(labels), SETUP_RANKING_DTYPE)

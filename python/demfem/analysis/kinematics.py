@@ -72,7 +72,7 @@ def middle_mean(values: np.ndarray, drop: float = 0.1, axis: int = -1) -> np.nda
 
 
 def spheres_riding_up(positions: np.ndarray, radii: np.ndarray, floor_z: float = 0.0,
-                      tolerance: float = 0.002) -> np.ndarray:
+                      tolerance: float = 0.002) -> np.ndarray | int:
     """Number of spheres per frame whose centre is more than ``tolerance`` (m) above the
     height of a sphere resting on the belt (``floor_z + radius``): spheres riding on their
     neighbours, which an upright cartridge cannot do (DESIGN section 4, effect "planar").

@@ -46,6 +46,7 @@ def bond_order(positions: np.ndarray, m: int, pairs: np.ndarray | None = None,
     if (pairs is None) == (cutoff is None):
         raise InvalidParameterError("invalid neighbours: give exactly one of pairs and cutoff")
     if pairs is None:
+        assert cutoff is not None  # exactly one of the two was given, checked above
         if not (np.isfinite(cutoff) and cutoff > 0):
             raise InvalidParameterError(f"invalid cutoff = {cutoff!r}: must be finite and in "
                                         "(0, inf)")

@@ -64,7 +64,7 @@ def _draw(ax, scene: SceneDescription, positions: np.ndarray, time: float,
         facecolors=[TAG_COLOURS.get(int(t), TAG_COLOURS[Tag.NONE]) for t in tags[order]],
         edgecolors="black", linewidths=0.3)
     ax.add_collection(spheres)
-    walls = LineCollection(_wall_segments(scene, time), colors="black", linewidths=2.0)
+    walls = LineCollection(list(_wall_segments(scene, time)), colors="black", linewidths=2.0)
     ax.add_collection(walls)
     return spheres, walls
 
@@ -114,7 +114,7 @@ def plot_table_snapshot(path: str | Path, scene: SceneDescription,
 
 
 def animate_table(path: str | Path, scene: SceneDescription, positions: np.ndarray,
-                  times: Sequence[float], fps: float = 10.0, dpi: int = 80) -> Path:
+                  times: Sequence[float], fps: int = 10, dpi: int = 80) -> Path:
     """Write an animated GIF of the table seen from above (like the paper's Movie 1).
 
     Args:
@@ -122,23 +122,24 @@ def animate_table(path: str | Path, scene: SceneDescription, positions: np.ndarr
         scene: the scene description.
         positions: (n_frames, N, 3) centres in m; NaN rows are removed spheres.
         times: (n_frames,) simulated times, s.
-        fps: frames per second of the animation.
+        fps: frames per second of the animation (GIF frame times are whole
+            milliseconds, so a whole number of frames per second).
         dpi: resolution.
     """
     frames = np.asarray(positions, float)
-    times = np.asarray(times, float)
+    frame_times = np.asarray(times, float)
     if frames.ndim != 3 or frames.shape[1:] != (scene.n_particles, 3):
         raise ShapeError(f"shape mismatch for positions: expected (n_frames, "
                          f"{scene.n_particles}, 3), got {frames.shape}")
-    if times.shape != (len(frames),):
+    if frame_times.shape != (len(frames),):
         raise ShapeError(f"shape mismatch for times: expected ({len(frames)},), "
-                         f"got {times.shape}")
-    if not (np.isfinite(fps) and fps > 0):
-        raise InvalidParameterError(f"invalid fps = {fps!r}: must be finite and in (0, inf)")
+                         f"got {frame_times.shape}")
+    if isinstance(fps, bool) or not isinstance(fps, (int, np.integer)) or fps < 1:
+        raise InvalidParameterError(f"invalid fps = {fps!r}: must be a whole number >= 1")
     fig, ax = plt.subplots(figsize=(10, 4.5))
     try:
         _setup_axes(ax, scene)
-        spheres, walls = _draw(ax, scene, frames[0], float(times[0]), scene.tags)
+        spheres, walls = _draw(ax, scene, frames[0], float(frame_times[0]), scene.tags)
         order = np.argsort(scene.tags != Tag.NONE, kind="stable")
         title = ax.set_title("")
         fig.tight_layout()
@@ -146,8 +147,8 @@ def animate_table(path: str | Path, scene: SceneDescription, positions: np.ndarr
         def update(k: int):
             present = np.all(np.isfinite(frames[k]), axis=1)
             spheres.set_offsets(np.where(present[order, None], frames[k][order, :2], np.nan))
-            walls.set_segments(_wall_segments(scene, float(times[k])))
-            title.set_text(f"t = {times[k]:.2f} s")
+            walls.set_segments(list(_wall_segments(scene, float(frame_times[k]))))
+            title.set_text(f"t = {frame_times[k]:.2f} s")
             return spheres, walls, title
 
         animation = FuncAnimation(fig, update, frames=len(frames), blit=False)

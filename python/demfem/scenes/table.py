@@ -490,6 +490,13 @@ class AccumulationTable:
             column += 1
         return np.array(sites, float).reshape(-1, 2)
 
+    def _square_row_y(self) -> np.ndarray:
+        """y of the rows of the square packing, m, centred across the table (the width need
+        not be a whole number of pitches)."""
+        rows = self.rows_in_rectangle
+        return (0.5 * (self.width - rows * self.pitch) + 0.5 * self.pitch
+                + self.pitch * np.arange(rows))
+
     def _square_columns_available(self) -> int:
         """Square columns that fit between the back wall and the interface."""
         columns = int(math.floor(self.length / self.pitch + 1e-9))
@@ -507,16 +514,15 @@ class AccumulationTable:
         hexagonal = self._hexagonal_sites()
         rows = self.rows_in_rectangle
         n_square = self.n_spheres - len(hexagonal)
-        # Centre the rows across the table when the width is not a whole number of pitches.
-        y_rows = 0.5 * (self.width - rows * p) + half + p * np.arange(rows)
-        square = []
+        y_rows = self._square_row_y()
+        sites = []
         for k in range(n_square):
             column, row = divmod(k, rows)
             in_column = min(rows, n_square - column * rows)
             # A partial (most upstream) column is centred in y.
             row += (rows - in_column) // 2
-            square.append((self.length - half - column * p, y_rows[row]))
-        square = np.array(square, float)
+            sites.append((self.length - half - column * p, y_rows[row]))
+        square = np.array(sites, float)
         xy = np.vstack([hexagonal, square])
         positions = np.column_stack([xy, np.full(len(xy), r)])
 
@@ -529,7 +535,7 @@ class AccumulationTable:
         centre = square.mean(axis=0)
         tags[rest[np.argmin(np.linalg.norm(xy[rest] - centre, axis=1))]] = Tag.RECTANGULAR_CENTRE
         hex_index = np.arange(n_hex)
-        chosen = []
+        chosen: list[int] = []
         for tag, target in ((Tag.TRIANGULAR_CENTRE, hexagonal.mean(axis=0)),
                             (Tag.UPPER_VERTEX, np.array([self.length, self.width])),
                             (Tag.LOWER_VERTEX, np.array([self.length, 0.0]))):
@@ -594,9 +600,9 @@ class AccumulationTable:
         r, half = self.sphere_radius, 0.5 * self.pitch
         refeed = None
         if self.refeed:
-            rows = self.rows_in_rectangle
-            y_rows = 0.5 * (self.width - rows * self.pitch) + half + self.pitch * np.arange(rows)
-            sites = np.column_stack([np.full(rows, half), y_rows, np.full(rows, r)])
+            y_rows = self._square_row_y()
+            sites = np.column_stack([np.full(len(y_rows), half), y_rows,
+                                     np.full(len(y_rows), r)])
             refeed = {"sites": sites, "velocity": np.zeros(3)}
         description = SceneDescription(
             positions=positions,
