@@ -158,6 +158,16 @@ def test_clogging_allowed_and_reported(table):
     assert narrow.build().n_particles == 840
 
 
+@pytest.mark.parametrize("amplitude", [0.01, 0.02, 0.05, 0.075])
+def test_paper_amplitude_sweep_fits_one_geometry(amplitude):
+    # The recipe of the module docstring: narrowest opening 2 cm, tilted wall 0.24 m at 45 deg.
+    t = AccumulationTable(gate_amplitude=amplitude, opening_width=amplitude + 0.02,
+                          tilted_wall_length=0.24)
+    assert t.min_opening_width == pytest.approx(0.02)
+    assert t.max_opening_width <= t.tilted_wall_gap
+    assert t.build().n_particles == 840
+
+
 def test_overlapping_start_positions_are_refused(scene):
     pos = scene.positions.copy()
     pos[1] = pos[0] + [0.001, 0, 0]

@@ -34,8 +34,12 @@ the belt surface is the plane z = 0. Top view::
   0 < w0 - A and w0 + A <= y_tip (validated). The minimum width w0 - A may be smaller than a
   sphere diameter: this is allowed on purpose, since clogging is what the paper's A = 1 cm run
   shows; :attr:`AccumulationTable.clogging_possible` says whether it can happen.
+  For the paper's sweep A in {1, 2, 5, 7.5} cm on one geometry, keep the narrowest opening at
+  2 cm with opening_width = A + 0.02 m; that needs y_tip >= 2 A + 0.02 m = 0.17 m at
+  A = 7.5 cm, e.g. tilted_wall_length = 0.24 m at 45 degrees (840 spheres still fit).
 * Spheres whose centre passes x_end + radius have left through the opening and are removed
-  (optionally re-fed upstream at x = radius + gap, see ``refeed``).
+  (with ``refeed``, re-inserted upstream at x = pitch/2, one site per row of the square
+  packing; the most upstream square column is then left empty at t = 0).
 
 The start configuration follows Fig. 4: a hexagonal packing fills the triangular section
 (columns parallel to y, sqrt(3)/2 pitch apart along x, every other column shifted by half a
@@ -66,11 +70,15 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import tomllib
 from dataclasses import dataclass, field
 from enum import IntEnum
 from pathlib import Path
 from typing import Any, Mapping
+
+try:
+    import tomllib
+except ModuleNotFoundError:  # Python < 3.11: the same parser, published as tomli
+    import tomli as tomllib  # type: ignore[no-redef]
 
 import numpy as np
 from scipy.spatial import cKDTree
