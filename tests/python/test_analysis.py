@@ -10,6 +10,7 @@ from demfem.analysis import (
     bond_order_psi6,
     collision_onset_table,
     contact_pairs_from_positions,
+    coordination_from_positions,
     coordination_number,
     coordination_series,
     first_line_force,
@@ -83,6 +84,15 @@ def test_hexagonal_packing_coordination():
     inside = interior(pos, 1.5 * R)
     assert inside.sum() == 36
     assert np.all(z[inside] == 6)
+
+
+def test_coordination_from_positions_over_frames():
+    square = square_lattice(3)
+    frames = np.stack([square, square * [2.0, 2.0, 1.0]])  # the second frame pulled apart
+    z = coordination_from_positions(frames, np.full(9, R), gap_tolerance=1e-9)
+    assert z.shape == (2, 9)
+    assert z[0].tolist() == [2, 3, 2, 3, 4, 3, 2, 3, 2] and z[1].sum() == 0
+    assert coordination_from_positions(square, np.full(9, R), 1e-9)[4] == 4
 
 
 def test_gap_tolerance_counts_near_contacts_only():

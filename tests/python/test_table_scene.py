@@ -141,6 +141,17 @@ def test_walls_belt_and_gate(table, scene):
     assert scene.materials["glass"]["restitution"] == 0.5
 
 
+def test_harmonic_motion_with_phase():
+    motion = {"kind": "harmonic", "direction": np.array([0.0, 1.0, 0.0]), "amplitude": 0.02,
+              "period": 2.0, "phase": math.pi / 2}
+    assert wall_displacement(motion, 0.0).tolist() == pytest.approx([0.0, 0.02, 0.0])
+    assert wall_displacement(motion, 1.0).tolist() == pytest.approx([0.0, -0.02, 0.0])
+    assert wall_velocity(motion, 0.5)[1] == pytest.approx(-0.02 * math.pi)
+    assert wall_displacement({"kind": "fixed"}, 3.0).tolist() == [0.0, 0.0, 0.0]
+    t = AccumulationTable(gate_phase=math.pi / 2)
+    assert t.opening_width_at([0.0, 1.0]).tolist() == pytest.approx([0.06, 0.02])
+
+
 def test_refeed_sites_are_free_and_upstream(table):
     scene = dataclasses.replace(table, refeed=True).build()
     sites = scene.refeed["sites"]

@@ -12,6 +12,7 @@ from demfem.analysis.collisions import (
 )
 from demfem.analysis.coordination import (
     contact_pairs_from_positions,
+    coordination_from_positions,
     coordination_number,
     coordination_series,
     mean_coordination,
@@ -38,6 +39,7 @@ __all__ = [
     "bond_order_psi6",
     "collision_onset_table",
     "contact_pairs_from_positions",
+    "coordination_from_positions",
     "coordination_number",
     "coordination_series",
     "first_line_force",

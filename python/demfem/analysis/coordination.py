@@ -16,6 +16,7 @@ from demfem.errors import InvalidParameterError, ShapeError
 
 __all__ = [
     "contact_pairs_from_positions",
+    "coordination_from_positions",
     "coordination_number",
     "coordination_series",
     "mean_coordination",
@@ -84,6 +85,24 @@ def coordination_series(pairs_per_frame: Sequence[np.ndarray], n_particles: int)
     contact list per frame."""
     return np.array([coordination_number(p, n_particles) for p in pairs_per_frame],
                     dtype=np.int64).reshape(len(pairs_per_frame), n_particles)
+
+
+def coordination_from_positions(positions: np.ndarray, radii: np.ndarray,
+                                gap_tolerance: float = 0.0) -> np.ndarray:
+    """Coordination of every sphere from its centres, for one frame (N, 3) -> (N,) or a
+    recording (n_frames, N, 3) -> (n_frames, N); contacts as in
+    :func:`contact_pairs_from_positions` (surface gap <= ``gap_tolerance``, m). Spheres with
+    NaN rows (removed) get 0; leave them out of means with ``present``."""
+    pos = np.asarray(positions, float)
+    if pos.ndim == 2:
+        return coordination_number(contact_pairs_from_positions(pos, radii, gap_tolerance),
+                                   len(pos))
+    if pos.ndim != 3:
+        raise ShapeError(f"shape mismatch for positions: expected (N, 3) or (n_frames, N, 3), "
+                         f"got {pos.shape}")
+    return coordination_series(
+        [contact_pairs_from_positions(frame, radii, gap_tolerance) for frame in pos],
+        pos.shape[1])
 
 
 def tag_mask(tags: np.ndarray, *codes: int) -> np.ndarray:

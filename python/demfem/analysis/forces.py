@@ -33,8 +33,9 @@ def particle_contact_force(pairs: np.ndarray, pair_forces: np.ndarray, n_particl
         pairs: (n_c, 2) particle indices (i, j) of each contact.
         pair_forces: (n_c, 3) force on particle i from particle j, N (j receives the opposite).
         n_particles: N.
-        kind: "net" for the resultant vector (what Yade's ``O.forces.f`` reports for
-            sphere-sphere contacts), or "sum" for the sum of the magnitudes of the contact
+        kind: "net" for the resultant of the listed contact forces (Yade's ``O.forces.f``
+            is this resultant over all of a body's contacts, walls and belt included, when
+            those are in the list), or "sum" for the sum of the magnitudes of the contact
             forces, which stays large in a jammed pack whose forces cancel.
 
     Returns:
