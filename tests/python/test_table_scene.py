@@ -179,6 +179,26 @@ def test_paper_amplitude_sweep_fits_one_geometry(amplitude):
     assert t.build().n_particles == 840
 
 
+def test_description_save_load_round_trip(tmp_path, table):
+    scene = dataclasses.replace(table, refeed=True).build()
+    path = scene.save(tmp_path / "scene.npz")
+    back = type(scene).load(path)
+    assert np.array_equal(back.positions, scene.positions)
+    assert np.array_equal(back.tags, scene.tags) and back.tags.dtype == np.int32
+    assert back.effects == scene.effects and back.tag_names == scene.tag_names
+    assert back.materials == scene.materials and back.planar is False
+    gate, gate_back = scene.wall("gate"), back.wall("gate")
+    assert np.array_equal(gate_back["vertices"], gate["vertices"])
+    assert np.array_equal(gate_back["motion"]["direction"], gate["motion"]["direction"])
+    assert gate_back["motion"]["period"] == 2.0
+    assert back.wall("belt")["top_view"] is None
+    assert np.array_equal(back.refeed["sites"], scene.refeed["sites"])
+    assert np.array_equal(back.removal["normal"], [1.0, 0.0, 0.0])
+    assert AccumulationTable(**back.parameters) == dataclasses.replace(table, refeed=True)
+    back.check_start_positions()
+    assert [p.name for p in tmp_path.iterdir()] == ["scene.npz"]
+
+
 def test_overlapping_start_positions_are_refused(scene):
     pos = scene.positions.copy()
     pos[1] = pos[0] + [0.001, 0, 0]

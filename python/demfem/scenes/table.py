@@ -69,6 +69,7 @@ the caption and text; all are chosen on the start positions):
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
 from dataclasses import dataclass, field
 from enum import IntEnum
@@ -84,7 +85,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from demfem.errors import DemfemIOError, InvalidParameterError, check_range
-from demfem.io.atomic import write_text_atomic
+from demfem.io.atomic import atomic_path, write_text_atomic
 
 __all__ = [
     "AccumulationTable",
@@ -215,6 +216,75 @@ class SceneDescription:
                 return w
         names = ", ".join(w["name"] for w in self.walls)
         raise InvalidParameterError(f"invalid wall name = {name!r}: must be one of {names}")
+
+    # Keys of wall, motion, removal and refeed dicts that hold vectors: stored as lists in the
+    # file, restored as arrays.
+    _VECTOR_KEYS = ("point", "normal", "vertices", "surface_velocity", "top_view", "direction",
+                    "sites", "velocity")
+
+    def save(self, path: str | Path) -> Path:
+        """Save to a ``.npz`` file (arrays as arrays, the rest as one JSON document; no
+        pickle), written atomically; :meth:`load` reads it back."""
+
+        def plain(value: Any) -> Any:
+            if isinstance(value, np.ndarray):
+                return value.tolist()
+            if isinstance(value, (np.floating, np.integer)):
+                return value.item()
+            if isinstance(value, dict):
+                return {str(k): plain(v) for k, v in value.items()}
+            if isinstance(value, (list, tuple)):
+                return [plain(v) for v in value]
+            return value
+
+        document = {
+            "tag_names": plain(self.tag_names), "walls": plain(self.walls),
+            "effects": list(self.effects), "materials": plain(self.materials),
+            "particle_material": self.particle_material, "removal": plain(self.removal),
+            "refeed": plain(self.refeed), "planar": self.planar,
+            "parameters": plain(self.parameters),
+        }
+        with atomic_path(path, suffix=".npz") as tmp:
+            with open(tmp, "wb") as handle:  # a handle: np.savez would append ".npz" to a name
+                np.savez(handle, positions=self.positions, radii=self.radii,
+                         masses=self.masses, tags=self.tags, gravity=self.gravity,
+                         document=np.array(json.dumps(document)))
+        return Path(path)
+
+    @classmethod
+    def load(cls, path: str | Path) -> "SceneDescription":
+        """Read a description written by :meth:`save`."""
+
+        def arrays(value: Any) -> Any:
+            if isinstance(value, dict):
+                return {k: (np.asarray(v, float) if k in cls._VECTOR_KEYS and v is not None
+                            else arrays(v)) for k, v in value.items()}
+            if isinstance(value, list):
+                return [arrays(v) for v in value]
+            return value
+
+        try:
+            with np.load(path, allow_pickle=False) as data:
+                document = json.loads(str(data["document"]))
+                fields = {k: data[k] for k in ("positions", "radii", "masses", "tags",
+                                               "gravity")}
+        except OSError as exc:
+            raise DemfemIOError(f"i/o error on {path}: {exc}") from None
+        except (KeyError, ValueError) as exc:
+            raise InvalidParameterError(
+                f"invalid scene description file {path}: {exc}") from None
+        return cls(
+            tag_names={int(k): v for k, v in document["tag_names"].items()},
+            walls=arrays(document["walls"]),
+            effects=tuple(document["effects"]),
+            materials=document["materials"],
+            particle_material=document["particle_material"],
+            removal=arrays(document["removal"]),
+            refeed=arrays(document["refeed"]),
+            planar=bool(document["planar"]),
+            parameters=document["parameters"],
+            **fields,
+        )
 
     def check_start_positions(self) -> None:
         """Raise :class:`InvalidParameterError` if two spheres overlap or a sphere is not
