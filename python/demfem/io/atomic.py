@@ -1,0 +1,56 @@
+"""Atomic file writes: a reader (ParaView, a sweep that resumes, a second process) never sees a
+half-written file, because the content goes to a temporary file in the same directory that is
+then renamed over the target with :func:`os.replace` (atomic on POSIX and Windows)."""
+from __future__ import annotations
+
+import os
+import tempfile
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Iterator, Union
+
+from demfem.errors import DemfemIOError
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+__all__ = ["atomic_path", "write_bytes_atomic", "write_text_atomic"]
+
+
+@contextmanager
+def atomic_path(path: PathLike, suffix: str = "") -> Iterator[Path]:
+    """Yield a temporary path next to ``path``; on normal exit rename it onto ``path``.
+
+    ``suffix`` is the temporary file's extension, for writers that infer the format from it
+    (matplotlib, Pillow). On an exception the temporary file is removed and ``path`` is left
+    untouched.
+    """
+    target = Path(path)
+    directory = target.parent if str(target.parent) else Path(".")
+    if not directory.is_dir():
+        raise DemfemIOError(f"i/o error on {target}: directory {directory} does not exist")
+    fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp" + suffix,
+                                    dir=directory)
+    os.close(fd)
+    tmp = Path(tmp_name)
+    # mkstemp makes the file private (0600); give the result the usual permissions instead.
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp, 0o666 & ~umask)
+    try:
+        yield tmp
+        os.replace(tmp, target)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+
+
+def write_bytes_atomic(path: PathLike, data: bytes) -> Path:
+    """Write ``data`` to ``path`` atomically; return the path."""
+    with atomic_path(path) as tmp:
+        tmp.write_bytes(data)
+    return Path(path)
+
+
+def write_text_atomic(path: PathLike, text: str) -> Path:
+    """Write UTF-8 ``text`` to ``path`` atomically; return the path."""
+    return write_bytes_atomic(path, text.encode("utf-8"))

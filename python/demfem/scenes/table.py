@@ -1,0 +1,809 @@
+"""The accumulation table of Boso et al. (2021), Fig. 4, as an engine-neutral scene.
+
+Frame and units (SI): x along the belt (the belt moves towards +x), y across the table, z up;
+the belt surface is the plane z = 0. Top view::
+
+      y = width  +---------------------------+.
+                 |                           |  `.  tilted wall, length l, angle theta
+                 |   rectangular section     |    `.   below the +x direction
+                 |   (square packing)        | tri-  `.
+                 |                           | angular |  <- gate: plate in the plane
+                 |                           | section |     x = x_end, slides along y
+      y = 0      +---------------------------+---------+ ..  opening 0 <= y <= w(t)
+               x = 0                    x = length    x = x_end = length + l cos(theta)
+
+* Rectangular section 0 <= x <= ``length``, 0 <= y <= ``width``, closed upstream by a wall at
+  x = 0 and on the sides by the walls y = 0 ("lower") and y = ``width`` ("upper").
+* Constricted (triangular) section: the lower side wall runs on to x_end; the upper boundary is
+  one vertical tilted wall from (length, width), of length l = ``tilted_wall_length`` at the
+  angle theta = ``tilted_wall_angle_deg`` below +x. Its tip is at (x_end, y_tip) with
+  y_tip = width - l sin(theta): the tilted wall alone leaves a gap 0 <= y <= y_tip at x = x_end
+  ("the length of the tilted wall and the angle univocally define the geometry of the
+  opening", paper, section on Fig. 4).
+* The gate (the only moving wall) is a vertical plate in the plane x = x_end that slides along
+  y, in its own plane, between the lower side wall and the tilted wall's tip. Its lower edge is
+  at y = w(t), so the opening is 0 <= y <= w(t) with
+
+      w(t) = opening_width + gate_amplitude * sin(2 pi t / gate_period + gate_phase).
+
+  ``gate_amplitude`` is A of the paper (the paper sweeps A in {1, 2, 5, 7.5} cm) and
+  ``opening_width`` is the mean width w0. Sliding in its own plane means the gate never opens
+  a gap to another wall, whatever A. The gate plate reaches up past the tilted wall's tip by
+  A plus one sphere radius, so at its lowest position it still closes y_tip.
+  The opening must never close and must stay inside the gap the tilted wall leaves:
+  0 < w0 - A and w0 + A <= y_tip (validated). The minimum width w0 - A may be smaller than a
+  sphere diameter: this is allowed on purpose, since clogging is what the paper's A = 1 cm run
+  shows; :attr:`AccumulationTable.clogging_possible` says whether it can happen.
+  For the paper's sweep A in {1, 2, 5, 7.5} cm on one geometry, keep the narrowest opening at
+  2 cm with opening_width = A + 0.02 m; that needs y_tip >= 2 A + 0.02 m = 0.17 m at
+  A = 7.5 cm, e.g. tilted_wall_length = 0.24 m at 45 degrees (840 spheres still fit).
+* Spheres whose centre passes x_end + radius have left through the opening and are removed
+  (with ``refeed``, re-inserted upstream at x = pitch/2, one site per row of the square
+  packing; the most upstream square column is then left empty at t = 0).
+
+The start configuration follows Fig. 4: a hexagonal packing fills the triangular section
+(columns parallel to y, sqrt(3)/2 pitch apart along x, every other column shifted by half a
+pitch; the first column half a pitch downstream of x = length), and a square packing fills
+the rectangular section from the interface x = ``length`` upstream, column by column, until
+``n_spheres`` are placed (the most upstream column may be partial, centred in y). The pitch is
+one diameter times (1 + ``packing_gap``), and every sphere keeps half of that gap from the walls,
+so nothing touches at t = 0.
+
+Tags (paper Fig. 4, whose image is not in the source text, so these rules are our reading of
+the caption and text; all are chosen on the start positions):
+
+* FIRST_LINE (magenta): every sphere of the square column nearest the constricted section
+  (centres at x = length - pitch/2): "the spheres lying close to the constricted section ...
+  initially at the boundary ... with square packing on the rectangular part and hexagonal on
+  the triangular side".
+* RECTANGULAR_CENTRE (cyan): the square-packed sphere, not in the first line, nearest the
+  centroid of all square-packed start positions.
+* TRIANGULAR_CENTRE (green): the hexagonally packed sphere nearest the centroid of all
+  hexagonally packed start positions.
+* UPPER_VERTEX (yellow): the hexagonally packed sphere nearest the corner (length, width) where
+  the tilted wall meets the upper side wall.
+* LOWER_VERTEX (blue): the hexagonally packed sphere nearest the corner (length, 0), the
+  triangular section's vertex on the lower side wall.
+* NONE: every other sphere.
+"""
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+from dataclasses import dataclass, field
+from enum import IntEnum
+from pathlib import Path
+from typing import Any, Mapping
+
+try:
+    import tomllib
+except ModuleNotFoundError:  # Python < 3.11: the same parser, published as tomli
+    import tomli as tomllib  # type: ignore[no-redef]
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from demfem.errors import DemfemIOError, InvalidParameterError, check_range
+from demfem.io.atomic import atomic_path, write_text_atomic
+
+__all__ = [
+    "AccumulationTable",
+    "SceneDescription",
+    "Tag",
+    "TAG_NAMES",
+    "wall_displacement",
+    "wall_velocity",
+]
+
+#: Name of this scene in scene files (the optional key ``scene``).
+SCENE_NAME = "accumulation_table"
+
+
+class Tag(IntEnum):
+    """Integer codes of the tagged spheres of Fig. 4 (``SceneDescription.tags``)."""
+
+    NONE = 0
+    TRIANGULAR_CENTRE = 1
+    RECTANGULAR_CENTRE = 2
+    UPPER_VERTEX = 3
+    LOWER_VERTEX = 4
+    FIRST_LINE = 5
+
+
+#: Readable names of the tag codes, e.g. for legends and file point data.
+TAG_NAMES: dict[int, str] = {
+    Tag.NONE: "untagged",
+    Tag.TRIANGULAR_CENTRE: "triangular centre",
+    Tag.RECTANGULAR_CENTRE: "rectangular centre",
+    Tag.UPPER_VERTEX: "upper vertex",
+    Tag.LOWER_VERTEX: "lower vertex",
+    Tag.FIRST_LINE: "first line",
+}
+
+
+# --------------------------------------------------------------------------------------------
+# Wall motion convention: one place, used by engines, plots and tests alike.
+# --------------------------------------------------------------------------------------------
+
+def wall_displacement(motion: Mapping[str, Any], t: float) -> np.ndarray:
+    """Displacement (3,) in m of a wall at time ``t`` (s) from its reference position.
+
+    ``{"kind": "fixed"}`` never moves. ``{"kind": "harmonic", "direction", "amplitude",
+    "period", "phase"}`` moves rigidly by
+    ``direction * amplitude * sin(2 pi t / period + phase)`` (direction a unit vector,
+    amplitude in m, period in s, phase in rad). The reference position is the one at which the
+    sine is zero, i.e. the wall's vertices as stored in the description.
+    """
+    if motion["kind"] == "fixed":
+        return np.zeros(3)
+    phase = 2.0 * math.pi * t / motion["period"] + motion["phase"]
+    return np.asarray(motion["direction"], float) * motion["amplitude"] * math.sin(phase)
+
+
+def wall_velocity(motion: Mapping[str, Any], t: float) -> np.ndarray:
+    """Velocity (3,) in m/s of a wall at time ``t`` (s); the time derivative of
+    :func:`wall_displacement`."""
+    if motion["kind"] == "fixed":
+        return np.zeros(3)
+    omega = 2.0 * math.pi / motion["period"]
+    phase = omega * t + motion["phase"]
+    return np.asarray(motion["direction"], float) * motion["amplitude"] * omega * math.cos(phase)
+
+
+# --------------------------------------------------------------------------------------------
+# The engine-neutral description
+# --------------------------------------------------------------------------------------------
+
+@dataclass(frozen=True, eq=False)
+class SceneDescription:
+    """Everything an engine needs to run a scene, as numpy arrays and plain data (SI units).
+
+    Attributes:
+        positions: (N, 3) sphere centres at t = 0, m.
+        radii: (N,) sphere radii, m.
+        masses: (N,) sphere masses, kg.
+        tags: (N,) int32 tag codes (:class:`Tag`).
+        tag_names: tag code -> readable name.
+        walls: list of dicts, each with
+            ``name``; ``kind`` "plane" (``point`` (3,), ``normal`` (3,) unit, pointing into the
+            space the spheres occupy) or "polygon" (``vertices`` (k, 3) planar and convex,
+            ``normal`` (3,) unit, the side the spheres are on); ``motion`` (see
+            :func:`wall_displacement`); ``surface_velocity`` (3,) m/s, the velocity of the
+            wall's surface that enters the contact law while the geometry stays put (the belt);
+            ``material`` (key of ``materials``); ``top_view`` (2, 2) the wall's trace in the
+            table plane at its reference position, for drawing (planes are infinite for
+            contact; the trace shows the physical wall's extent), or ``None`` for the belt.
+        effects: names of the physics the scene needs; an engine must refuse to run a scene
+            whose effects it does not implement, and must not add others.
+        materials: material name -> {"young_modulus" Pa, "poisson_ratio", "density" kg/m^3,
+            "friction", "restitution", "rolling_resistance"}.
+        particle_material: key of ``materials`` for the spheres.
+        gravity: (3,) m/s^2.
+        removal: {"kind": "half_space", "point" (3,), "normal" (3,)}: a sphere whose centre c
+            has (c - point) . normal > 0 has left the table and is removed.
+        refeed: ``None``, or {"sites" (k, 3), "velocity" (3,)}: a removed sphere is re-inserted,
+            at rest relative to ``velocity``, at the first site (in order) where it overlaps
+            nothing; if no site is free it waits for the next step.
+        planar: True if the "planar" effect is on (centres kept at z = radius).
+        parameters: the scene's own parameters, for the record.
+    """
+
+    positions: np.ndarray
+    radii: np.ndarray
+    masses: np.ndarray
+    tags: np.ndarray
+    tag_names: dict[int, str]
+    walls: list[dict[str, Any]]
+    effects: tuple[str, ...]
+    materials: dict[str, dict[str, float]]
+    particle_material: str
+    gravity: np.ndarray
+    removal: dict[str, Any]
+    refeed: dict[str, Any] | None
+    planar: bool
+    parameters: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def n_particles(self) -> int:
+        """Number of spheres at t = 0."""
+        return int(self.positions.shape[0])
+
+    def wall(self, name: str) -> dict[str, Any]:
+        """The wall called ``name``."""
+        for w in self.walls:
+            if w["name"] == name:
+                return w
+        names = ", ".join(w["name"] for w in self.walls)
+        raise InvalidParameterError(f"invalid wall name = {name!r}: must be one of {names}")
+
+    # Keys of wall, motion, removal and refeed dicts that hold vectors: stored as lists in the
+    # file, restored as arrays.
+    _VECTOR_KEYS = ("point", "normal", "vertices", "surface_velocity", "top_view", "direction",
+                    "sites", "velocity")
+
+    def save(self, path: str | Path) -> Path:
+        """Save to a ``.npz`` file (arrays as arrays, the rest as one JSON document; no
+        pickle), written atomically; :meth:`load` reads it back."""
+
+        def plain(value: Any) -> Any:
+            if isinstance(value, np.ndarray):
+                return value.tolist()
+            if isinstance(value, (np.floating, np.integer)):
+                return value.item()
+            if isinstance(value, dict):
+                return {str(k): plain(v) for k, v in value.items()}
+            if isinstance(value, (list, tuple)):
+                return [plain(v) for v in value]
+            return value
+
+        document = {
+            "tag_names": plain(self.tag_names), "walls": plain(self.walls),
+            "effects": list(self.effects), "materials": plain(self.materials),
+            "particle_material": self.particle_material, "removal": plain(self.removal),
+            "refeed": plain(self.refeed), "planar": self.planar,
+            "parameters": plain(self.parameters),
+        }
+        with atomic_path(path, suffix=".npz") as tmp:
+            with open(tmp, "wb") as handle:  # a handle: np.savez would append ".npz" to a name
+                np.savez(handle, positions=self.positions, radii=self.radii,
+                         masses=self.masses, tags=self.tags, gravity=self.gravity,
+                         document=np.array(json.dumps(document)))
+        return Path(path)
+
+    @classmethod
+    def load(cls, path: str | Path) -> "SceneDescription":
+        """Read a description written by :meth:`save`."""
+
+        def arrays(value: Any) -> Any:
+            if isinstance(value, dict):
+                return {k: (np.asarray(v, float) if k in cls._VECTOR_KEYS and v is not None
+                            else arrays(v)) for k, v in value.items()}
+            if isinstance(value, list):
+                return [arrays(v) for v in value]
+            return value
+
+        try:
+            with np.load(path, allow_pickle=False) as data:
+                document = json.loads(str(data["document"]))
+                fields = {k: data[k] for k in ("positions", "radii", "masses", "tags",
+                                               "gravity")}
+        except OSError as exc:
+            raise DemfemIOError(f"i/o error on {path}: {exc}") from None
+        except (KeyError, ValueError) as exc:
+            raise InvalidParameterError(
+                f"invalid scene description file {path}: {exc}") from None
+        return cls(
+            tag_names={int(k): v for k, v in document["tag_names"].items()},
+            walls=arrays(document["walls"]),
+            effects=tuple(document["effects"]),
+            materials=document["materials"],
+            particle_material=document["particle_material"],
+            removal=arrays(document["removal"]),
+            refeed=arrays(document["refeed"]),
+            planar=bool(document["planar"]),
+            parameters=document["parameters"],
+            **fields,
+        )
+
+    def check_start_positions(self) -> None:
+        """Raise :class:`InvalidParameterError` if two spheres overlap or a sphere is not
+        inside every wall at t = 0.
+
+        "Inside" uses each wall's plane (a polygon's supporting plane): the signed distance of
+        the centre must be at least the radius. That is exact because the table is convex.
+        """
+        pos, rad = self.positions, self.radii
+        if not np.all(np.isfinite(pos)):
+            bad = int(np.flatnonzero(~np.all(np.isfinite(pos), axis=1))[0])
+            raise InvalidParameterError(
+                f"invalid positions[{bad}] = {pos[bad].tolist()}: must be finite")
+        tree = cKDTree(pos)
+        pairs = tree.query_pairs(2.0 * float(rad.max()), output_type="ndarray")
+        if len(pairs):
+            dist = np.linalg.norm(pos[pairs[:, 0]] - pos[pairs[:, 1]], axis=1)
+            overlap = rad[pairs[:, 0]] + rad[pairs[:, 1]] - dist
+            k = int(np.argmax(overlap))
+            if overlap[k] > 0.0:
+                i, j = pairs[k]
+                raise InvalidParameterError(
+                    f"invalid positions: spheres {i} and {j} overlap by {overlap[k]:.3g} m; "
+                    "start positions must not overlap")
+        for w in self.walls:
+            point = w["point"] if w["kind"] == "plane" else w["vertices"][0]
+            signed = (pos - point) @ np.asarray(w["normal"])
+            k = int(np.argmin(signed - rad))
+            if signed[k] < rad[k] * (1.0 - 1e-9):
+                raise InvalidParameterError(
+                    f"invalid positions[{k}] = {pos[k].tolist()}: the sphere crosses wall "
+                    f"{w['name']!r} (centre {signed[k]:.4g} m from it, radius {rad[k]:.4g} m); "
+                    "start positions must lie inside every wall")
+        ahead = (pos - self.removal["point"]) @ np.asarray(self.removal["normal"])
+        if np.any(ahead > 0):
+            k = int(np.argmax(ahead))
+            raise InvalidParameterError(
+                f"invalid positions[{k}] = {pos[k].tolist()}: the sphere starts in the removal "
+                "region; start positions must be on the table")
+
+
+# --------------------------------------------------------------------------------------------
+# The scene's parameters
+# --------------------------------------------------------------------------------------------
+
+def _is_bool(value: Any) -> bool:
+    return isinstance(value, (bool, np.bool_))
+
+
+@dataclass(frozen=True)
+class AccumulationTable:
+    """Parameters of the accumulation table (paper Fig. 4); SI units, validated on creation.
+
+    See the module docstring for the geometry, the gate law and the tag rules.
+
+    Attributes:
+        n_spheres: number of equivalent spheres at t = 0 (paper: 840).
+        sphere_radius: equivalent-sphere radius, m (paper: diameter about 1.6 cm).
+        sphere_mass: equivalent-sphere mass, kg (the cartridge's mass, about 5 g).
+        length: length of the rectangular section along the belt (x), m.
+        width: width of the table across the belt (y), m.
+        tilted_wall_length: length l of the tilted wall, m.
+        tilted_wall_angle_deg: angle theta of the tilted wall below the belt direction +x,
+            degrees, in (0, 90).
+        wall_height: height of all vertical walls, m (at least one diameter).
+        opening_width: mean opening width w0, m.
+        gate_amplitude: amplitude A of the opening's oscillation, m; 0 keeps the gate still.
+        gate_period: period T of the opening's oscillation, s.
+        gate_phase: phase of the oscillation at t = 0, rad (0: the opening is w0 and widening).
+        belt_velocity: belt surface speed along +x, m/s.
+        gravity: magnitude of gravity along -z, m/s^2.
+        young_modulus: Young's modulus of the glass (spheres and walls), Pa. The paper uses
+            45 GPa; type I borosilicate is nearer 64-74 GPa.
+        poisson_ratio: Poisson's ratio, in (-1, 0.5).
+        density: glass density, kg/m^3 (for contact laws; the sphere mass is ``sphere_mass``).
+        friction: Coulomb friction coefficient, sphere-sphere and sphere-wall (paper: 0.2).
+        restitution: normal coefficient of restitution, in (0, 1].
+        rolling_resistance: rolling-resistance coefficient; > 0 adds the effect
+            "rolling_resistance".
+        planar: keep the centres in one layer (effect "planar"): an upright 64 mm cartridge
+            cannot ride on top of its neighbours the way a sphere can.
+        refeed: re-insert removed spheres upstream to keep the population steady.
+        packing_gap: gap between neighbouring spheres at t = 0, as a fraction of the diameter.
+    """
+
+    n_spheres: int = 840
+    sphere_radius: float = 0.0081
+    sphere_mass: float = 0.0049
+    length: float = 0.70
+    width: float = 0.34
+    tilted_wall_length: float = 0.36
+    tilted_wall_angle_deg: float = 45.0
+    wall_height: float = 0.05
+    opening_width: float = 0.04
+    gate_amplitude: float = 0.02
+    gate_period: float = 2.0
+    gate_phase: float = 0.0
+    belt_velocity: float = 0.2
+    gravity: float = 9.81
+    young_modulus: float = 45e9
+    poisson_ratio: float = 0.22
+    density: float = 2230.0
+    friction: float = 0.2
+    restitution: float = 0.5
+    rolling_resistance: float = 0.0
+    planar: bool = False
+    refeed: bool = False
+    packing_gap: float = 0.01
+
+    # ---- validation ------------------------------------------------------------------------
+
+    def __post_init__(self) -> None:
+        # Every float field is normalised to a Python float; a wrong type names its field.
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            if f.type == "bool":
+                if not _is_bool(value):
+                    raise InvalidParameterError(
+                        f"invalid {f.name} = {value!r}: must be true or false")
+                object.__setattr__(self, f.name, bool(value))
+            elif f.type == "int":
+                if _is_bool(value) or not (isinstance(value, (int, np.integer))
+                                           or (isinstance(value, float) and value.is_integer())):
+                    raise InvalidParameterError(
+                        f"invalid {f.name} = {value!r}: must be a whole number")
+                object.__setattr__(self, f.name, int(value))
+            else:
+                if _is_bool(value):
+                    raise InvalidParameterError(
+                        f"invalid {f.name} = {value!r}: must be a real number")
+                try:
+                    number = float(value)
+                except (TypeError, ValueError):
+                    raise InvalidParameterError(
+                        f"invalid {f.name} = {value!r}: must be a real number") from None
+                # Finiteness and range are checked field by field in _validate, whose
+                # messages give each field's own allowed range.
+                object.__setattr__(self, f.name, number)
+        self._validate()
+
+    def _validate(self) -> None:
+        inf = math.inf
+        r = self.sphere_radius
+        check_range("sphere_radius", r, 0.0, inf)
+        check_range("sphere_mass", self.sphere_mass, 0.0, inf)
+        check_range("packing_gap", self.packing_gap, 0.0, 1.0, lo_open=False)
+        pitch = self.pitch
+        check_range("width", self.width, 2.0 * pitch, inf, lo_open=False)
+        check_range("length", self.length, 0.0, inf)
+        check_range("tilted_wall_angle_deg", self.tilted_wall_angle_deg, 0.0, 90.0)
+        sin_t = math.sin(math.radians(self.tilted_wall_angle_deg))
+        _explained(check_range, "tilted_wall_length", self.tilted_wall_length, 0.0,
+                   self.width / sin_t,
+                   why="the tilted wall must end above the lower side wall "
+                       "(width - tilted_wall_length*sin(angle) > 0)")
+        check_range("wall_height", self.wall_height, 2.0 * r, inf, lo_open=False)
+        y_tip = self.tilted_wall_gap
+        _explained(check_range, "opening_width", self.opening_width, 0.0, y_tip,
+                   hi_open=False,
+                   why=f"the mean opening must fit in the gap the tilted wall leaves "
+                       f"(width - tilted_wall_length*sin(angle) = {y_tip:.4g} m)")
+        a_max = min(self.opening_width, y_tip - self.opening_width)
+        _explained(check_range, "gate_amplitude", self.gate_amplitude, 0.0, a_max,
+                   lo_open=False, hi_open=self.opening_width <= y_tip - self.opening_width,
+                   why=f"the opening w(t) = opening_width +- gate_amplitude must stay in "
+                       f"(0, {y_tip:.4g}] m: it must never close (opening_width = "
+                       f"{self.opening_width:g} m) nor outgrow the gap the tilted wall leaves")
+        check_range("gate_period", self.gate_period, 0.0, inf)
+        check_range("gate_phase", self.gate_phase)
+        check_range("belt_velocity", self.belt_velocity, 0.0, inf, lo_open=False)
+        check_range("gravity", self.gravity, 0.0, inf, lo_open=False)
+        check_range("young_modulus", self.young_modulus, 0.0, inf)
+        check_range("poisson_ratio", self.poisson_ratio, -1.0, 0.5)
+        check_range("density", self.density, 0.0, inf)
+        check_range("friction", self.friction, 0.0, inf, lo_open=False)
+        check_range("restitution", self.restitution, 0.0, 1.0, hi_open=False)
+        check_range("rolling_resistance", self.rolling_resistance, 0.0, inf, lo_open=False)
+        n_min, n_max = self._sphere_count_range()
+        if not n_min <= self.n_spheres <= n_max:
+            raise InvalidParameterError(
+                f"invalid n_spheres = {self.n_spheres}: must be in [{n_min}, {n_max}] for this "
+                f"table ({n_min - 2 * self.rows_in_rectangle} fit the triangular section, plus "
+                f"at least two square columns of {self.rows_in_rectangle}; a longer `length` "
+                "holds more" + (", and refeed keeps the most upstream column free)"
+                                if self.refeed else ")"))
+
+    # ---- derived geometry ------------------------------------------------------------------
+
+    @property
+    def sphere_diameter(self) -> float:
+        """Sphere diameter, m."""
+        return 2.0 * self.sphere_radius
+
+    @property
+    def pitch(self) -> float:
+        """Centre distance of neighbours in the start packings, m."""
+        return self.sphere_diameter * (1.0 + self.packing_gap)
+
+    @property
+    def x_end(self) -> float:
+        """x of the opening (the gate plane), m."""
+        return self.length + self.tilted_wall_length * math.cos(
+            math.radians(self.tilted_wall_angle_deg))
+
+    @property
+    def tilted_wall_gap(self) -> float:
+        """y of the tilted wall's tip: the widest opening the geometry allows, m."""
+        return self.width - self.tilted_wall_length * math.sin(
+            math.radians(self.tilted_wall_angle_deg))
+
+    @property
+    def rows_in_rectangle(self) -> int:
+        """Rows (along y) of the square packing."""
+        return int(math.floor(self.width / self.pitch + 1e-9))
+
+    @property
+    def min_opening_width(self) -> float:
+        """Narrowest opening w0 - A, m."""
+        return self.opening_width - self.gate_amplitude
+
+    @property
+    def max_opening_width(self) -> float:
+        """Widest opening w0 + A, m."""
+        return self.opening_width + self.gate_amplitude
+
+    @property
+    def clogging_possible(self) -> bool:
+        """True if the narrowest opening is narrower than a sphere diameter, so a sphere can
+        be held at the opening (allowed on purpose: the paper's A = 1 cm run clogs)."""
+        return self.min_opening_width < self.sphere_diameter
+
+    def opening_width_at(self, t: np.ndarray | float) -> np.ndarray:
+        """Opening width w(t) = w0 + A sin(2 pi t / T + phase), m, at times ``t`` (s)."""
+        t = np.asarray(t, float)
+        return self.opening_width + self.gate_amplitude * np.sin(
+            2.0 * math.pi * t / self.gate_period + self.gate_phase)
+
+    @property
+    def effects(self) -> tuple[str, ...]:
+        """The physics this scene needs, derived from the parameters (DESIGN section 3)."""
+        names = []
+        if self.gravity > 0:
+            names.append("gravity")
+        if self.belt_velocity > 0:
+            names.append("belt")
+        if self.gate_amplitude > 0:
+            names.append("moving_walls")
+        if self.friction > 0:
+            names.append("friction")
+        # Rotation is needed whenever friction acts: the belt makes the spheres roll.
+        if self.friction > 0:
+            names.append("rotation")
+        names.append("damping")
+        if self.planar:
+            names.append("planar")
+        if self.rolling_resistance > 0:
+            names.append("rolling_resistance")
+        return tuple(names)
+
+    # ---- start positions -------------------------------------------------------------------
+
+    def _hexagonal_sites(self) -> np.ndarray:
+        """(k, 2) centres of the hexagonal packing of the constricted section, in columns
+        parallel to y from the interface x = length towards the opening."""
+        p, half = self.pitch, 0.5 * self.pitch
+        theta = math.radians(self.tilted_wall_angle_deg)
+        # Inward unit normal of the tilted wall and a point on it.
+        normal = np.array([-math.sin(theta), -math.cos(theta)])
+        corner = np.array([self.length, self.width])
+        sites = []
+        column = 0
+        while True:
+            x = self.length + half + column * p * math.sqrt(3.0) / 2.0
+            if x > self.x_end - half:
+                break
+            y = half if column % 2 == 0 else p
+            while y <= self.width - half:
+                if (np.array([x, y]) - corner) @ normal >= half:
+                    sites.append((x, y))
+                y += p
+            column += 1
+        return np.array(sites, float).reshape(-1, 2)
+
+    def _square_row_y(self) -> np.ndarray:
+        """y of the rows of the square packing, m, centred across the table (the width need
+        not be a whole number of pitches)."""
+        rows = self.rows_in_rectangle
+        return (0.5 * (self.width - rows * self.pitch) + 0.5 * self.pitch
+                + self.pitch * np.arange(rows))
+
+    def _square_columns_available(self) -> int:
+        """Square columns that fit between the back wall and the interface."""
+        columns = int(math.floor(self.length / self.pitch + 1e-9))
+        return columns - 1 if self.refeed else columns
+
+    def _sphere_count_range(self) -> tuple[int, int]:
+        n_hex = len(self._hexagonal_sites())
+        rows = self.rows_in_rectangle
+        return n_hex + 2 * rows, n_hex + rows * self._square_columns_available()
+
+    def start_positions(self) -> tuple[np.ndarray, np.ndarray]:
+        """Start centres (N, 3) in m and tags (N,), hexagonal sites first, then the square
+        columns from the interface upstream (see the module docstring)."""
+        p, half, r = self.pitch, 0.5 * self.pitch, self.sphere_radius
+        hexagonal = self._hexagonal_sites()
+        rows = self.rows_in_rectangle
+        n_square = self.n_spheres - len(hexagonal)
+        y_rows = self._square_row_y()
+        sites = []
+        for k in range(n_square):
+            column, row = divmod(k, rows)
+            in_column = min(rows, n_square - column * rows)
+            # A partial (most upstream) column is centred in y.
+            row += (rows - in_column) // 2
+            sites.append((self.length - half - column * p, y_rows[row]))
+        square = np.array(sites, float)
+        xy = np.vstack([hexagonal, square])
+        positions = np.column_stack([xy, np.full(len(xy), r)])
+
+        tags = np.zeros(len(xy), np.int32)
+        n_hex = len(hexagonal)
+        sq_index = np.arange(n_hex, len(xy))
+        first_line = sq_index[np.isclose(square[:, 0], self.length - half)]
+        tags[first_line] = Tag.FIRST_LINE
+        rest = sq_index[tags[sq_index] == Tag.NONE]
+        centre = square.mean(axis=0)
+        tags[rest[np.argmin(np.linalg.norm(xy[rest] - centre, axis=1))]] = Tag.RECTANGULAR_CENTRE
+        hex_index = np.arange(n_hex)
+        chosen: list[int] = []
+        for tag, target in ((Tag.TRIANGULAR_CENTRE, hexagonal.mean(axis=0)),
+                            (Tag.UPPER_VERTEX, np.array([self.length, self.width])),
+                            (Tag.LOWER_VERTEX, np.array([self.length, 0.0]))):
+            k = int(hex_index[np.argmin(np.linalg.norm(hexagonal - target, axis=1))])
+            if k in chosen:
+                raise InvalidParameterError(
+                    f"invalid tilted_wall_length = {self.tilted_wall_length:g}: the triangular "
+                    f"section holds too few spheres ({n_hex}) to tag its centre and both "
+                    "vertices separately; use a longer tilted wall")
+            chosen.append(k)
+            tags[k] = tag
+        return positions, tags
+
+    # ---- walls -----------------------------------------------------------------------------
+
+    def walls(self) -> list[dict[str, Any]]:
+        """The walls at their reference position (see :class:`SceneDescription`)."""
+        h, W, L, xe = self.wall_height, self.width, self.length, self.x_end
+        y_tip = self.tilted_wall_gap
+        theta = math.radians(self.tilted_wall_angle_deg)
+        fixed = {"kind": "fixed"}
+        still = np.zeros(3)
+
+        def plane(name, point, normal, top_view, surface_velocity=still):
+            return {"name": name, "kind": "plane", "point": np.array(point, float),
+                    "normal": np.array(normal, float), "motion": dict(fixed),
+                    "surface_velocity": np.array(surface_velocity, float),
+                    "material": "glass",
+                    "top_view": None if top_view is None else np.array(top_view, float)}
+
+        def vertical_polygon(name, a, b, normal, motion):
+            vertices = np.array([[a[0], a[1], 0.0], [b[0], b[1], 0.0],
+                                 [b[0], b[1], h], [a[0], a[1], h]])
+            return {"name": name, "kind": "polygon", "vertices": vertices,
+                    "normal": np.array(normal, float), "motion": motion,
+                    "surface_velocity": still.copy(), "material": "glass",
+                    "top_view": np.array([a, b], float)}
+
+        gate_top = y_tip + self.gate_amplitude + self.sphere_radius
+        gate_motion = ({"kind": "harmonic", "direction": np.array([0.0, 1.0, 0.0]),
+                        "amplitude": self.gate_amplitude, "period": self.gate_period,
+                        "phase": self.gate_phase}
+                       if self.gate_amplitude > 0 else dict(fixed))
+        return [
+            plane("belt", (0, 0, 0), (0, 0, 1), None, (self.belt_velocity, 0, 0)),
+            plane("back", (0, 0, 0), (1, 0, 0), [(0, 0), (0, W)]),
+            plane("lower_side", (0, 0, 0), (0, 1, 0), [(0, 0), (xe, 0)]),
+            plane("upper_side", (0, W, 0), (0, -1, 0), [(0, W), (L, W)]),
+            vertical_polygon("tilted", (L, W), (xe, y_tip),
+                             (-math.sin(theta), -math.cos(theta), 0.0), dict(fixed)),
+            vertical_polygon("gate", (xe, self.opening_width), (xe, gate_top),
+                             (-1.0, 0.0, 0.0), gate_motion),
+        ]
+
+    # ---- the description -------------------------------------------------------------------
+
+    def build(self) -> SceneDescription:
+        """The engine-neutral :class:`SceneDescription` of this table, checked for overlaps
+        and for spheres outside the walls."""
+        positions, tags = self.start_positions()
+        n = len(positions)
+        r, half = self.sphere_radius, 0.5 * self.pitch
+        refeed = None
+        if self.refeed:
+            y_rows = self._square_row_y()
+            sites = np.column_stack([np.full(len(y_rows), half), y_rows,
+                                     np.full(len(y_rows), r)])
+            refeed = {"sites": sites, "velocity": np.zeros(3)}
+        description = SceneDescription(
+            positions=positions,
+            radii=np.full(n, r),
+            masses=np.full(n, self.sphere_mass),
+            tags=tags,
+            tag_names=dict(TAG_NAMES),
+            walls=self.walls(),
+            effects=self.effects,
+            materials={"glass": {
+                "young_modulus": self.young_modulus,
+                "poisson_ratio": self.poisson_ratio,
+                "density": self.density,
+                "friction": self.friction,
+                "restitution": self.restitution,
+                "rolling_resistance": self.rolling_resistance,
+            }},
+            particle_material="glass",
+            gravity=np.array([0.0, 0.0, -self.gravity]),
+            removal={"kind": "half_space", "point": np.array([self.x_end + r, 0.0, 0.0]),
+                     "normal": np.array([1.0, 0.0, 0.0])},
+            refeed=refeed,
+            planar=self.planar,
+            parameters=dataclasses.asdict(self),
+        )
+        description.check_start_positions()
+        return description
+
+    # ---- scene files -----------------------------------------------------------------------
+
+    @classmethod
+    def from_dict(cls, values: Mapping[str, Any], source: str = "scene") -> "AccumulationTable":
+        """A table from a mapping of field names to values; unknown keys are errors."""
+        allowed = [f.name for f in dataclasses.fields(cls)]
+        values = dict(values)
+        scene = values.pop("scene", SCENE_NAME)
+        if scene != SCENE_NAME:
+            raise InvalidParameterError(
+                f"invalid scene = {scene!r} in {source}: must be {SCENE_NAME!r}")
+        for key in values:
+            if key not in allowed:
+                raise InvalidParameterError(
+                    f"unknown key {key!r} in {source}; allowed keys: scene, "
+                    + ", ".join(allowed))
+        return cls(**values)
+
+    @classmethod
+    def from_toml(cls, path: str | Path) -> "AccumulationTable":
+        """Load a table from a TOML file of ``key = value`` lines named as the fields (SI
+        units); missing keys take their defaults, unknown keys are errors."""
+        path = Path(path)
+        try:
+            text = path.read_text(encoding="utf-8")
+        except OSError as exc:
+            raise DemfemIOError(f"i/o error on {path}: {exc.strerror or exc}") from None
+        try:
+            values = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as exc:
+            raise InvalidParameterError(f"invalid TOML in {path}: {exc}") from None
+        for key, value in values.items():
+            if isinstance(value, dict):
+                raise InvalidParameterError(
+                    f"invalid [{key}] in {path}: the scene file is flat, one `key = value` "
+                    "per field, no tables")
+        return cls.from_dict(values, source=str(path))
+
+    def to_toml(self, path: str | Path) -> Path:
+        """Write this table as a TOML scene file (atomically); returns the path."""
+        return write_text_atomic(path, self.toml_text())
+
+    def toml_text(self) -> str:
+        """The TOML text that :meth:`from_toml` reads back to an equal table."""
+        lines = ["# demfem accumulation-table scene (SI units: m, kg, s, Pa; angle in degrees).",
+                 "# Geometry, gate law and tag rules: the docstring of demfem.scenes.table.",
+                 "# Missing keys take their defaults; unknown keys are errors.",
+                 f'scene = "{SCENE_NAME}"']
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            if isinstance(value, bool):
+                text = "true" if value else "false"
+            elif isinstance(value, int):
+                text = str(value)
+            elif value != 0 and not 1e-4 <= abs(value) < 1e5:
+                # Shortest round-trip form, readable for moduli: 4.5e+10, not 45000000000.0.
+                text = np.format_float_scientific(value, unique=True, trim="0")
+            else:
+                text = repr(float(value))
+            unit = _UNITS.get(f.name, "")
+            lines.append(f"{f.name} = {text}" + (f"  # {unit}" if unit else ""))
+        return "\n".join(lines) + "\n"
+
+
+#: Units of the fields, written as comments into scene files.
+_UNITS: dict[str, str] = {
+    "n_spheres": "spheres at t = 0",
+    "sphere_radius": "m",
+    "sphere_mass": "kg",
+    "length": "m, rectangular section along the belt (x)",
+    "width": "m, across the belt (y)",
+    "tilted_wall_length": "m",
+    "tilted_wall_angle_deg": "degrees below the belt direction, in (0, 90)",
+    "wall_height": "m",
+    "opening_width": "m, mean opening w0",
+    "gate_amplitude": "m, A in w(t) = w0 + A sin(2 pi t / T + phase)",
+    "gate_period": "s, T",
+    "gate_phase": "rad",
+    "belt_velocity": "m/s along +x",
+    "gravity": "m/s^2 along -z",
+    "young_modulus": "Pa",
+    "poisson_ratio": "-",
+    "density": "kg/m^3",
+    "friction": "Coulomb coefficient, sphere-sphere and sphere-wall",
+    "restitution": "normal coefficient of restitution",
+    "rolling_resistance": "coefficient; > 0 adds the effect rolling_resistance",
+    "planar": "keep centres in one layer (effect planar)",
+    "refeed": "re-insert removed spheres upstream",
+    "packing_gap": "gap between start neighbours, fraction of the diameter",
+}
+
+
+def _explained(check, name: str, value: Any, *args: Any, why: str, **kwargs: Any) -> float:
+    """Run a range check and append the physical reason for the range to its message."""
+    try:
+        return check(name, value, *args, **kwargs)
+    except InvalidParameterError as exc:
+        raise InvalidParameterError(f"{exc} ({why})") from None
