@@ -14,7 +14,7 @@ import numpy as np
 from demfem.cartridge import Cartridge
 from demfem.contact import MODELS, ContactBody, k_eq, max_contact_force
 from demfem.errors import check_positive
-from demfem.io import atomic_savefig, atomic_write_text
+from demfem.io import savefig_atomic, write_text_atomic
 
 __all__ = ["CalibrationTable", "force_vs_modulus", "plot_force_vs_modulus"]
 
@@ -48,7 +48,8 @@ class CalibrationTable:
         return "\n".join(lines)
 
 
-def force_vs_modulus(cartridge: Optional[Cartridge] = None, E: Optional[Sequence[float]] = None,
+def force_vs_modulus(cartridge: Optional[Cartridge] = None,
+                     E: "Optional[Sequence[float] | np.ndarray]" = None,
                      v_rel: float = 0.2) -> CalibrationTable:
     """Maximum force of two identical cartridges (as equivalent bodies) colliding head-on
     at ``v_rel`` (m/s), for each Young's modulus in ``E`` (Pa; default 25 values, 1e7–1e11),
@@ -97,7 +98,7 @@ def plot_force_vs_modulus(table: CalibrationTable, path: "str | Path",
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
     fig.tight_layout()
-    out = atomic_savefig(fig, path, dpi=130)
+    out = savefig_atomic(fig, path, dpi=130)
     plt.close(fig)
     return out
 
@@ -105,7 +106,7 @@ def plot_force_vs_modulus(table: CalibrationTable, path: "str | Path",
 def write_calibration(out_dir: "str | Path", table: CalibrationTable) -> tuple[Path, Path]:
     """Write ``calibration.csv`` and ``calibration_force_vs_E.png`` into ``out_dir``."""
     out_dir = Path(out_dir)
-    csv = atomic_write_text(out_dir / "calibration.csv", table.to_csv())
+    csv = write_text_atomic(out_dir / "calibration.csv", table.to_csv())
     png = plot_force_vs_modulus(table, out_dir / "calibration_force_vs_E.png")
     return csv, png
 

@@ -14,13 +14,16 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Literal, Optional
+from typing import TYPE_CHECKING, Literal, Optional
 
 import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 from demfem.errors import InvalidParameterError, check_positive, check_range
+
+if TYPE_CHECKING:
+    from demfem.cartridge import Cartridge
 
 __all__ = [
     "effective_modulus",
@@ -155,7 +158,7 @@ class ContactBody:
                 raise InvalidParameterError("invalid E = inf: a rigid body cannot be a shell")
 
     @classmethod
-    def from_cartridge(cls, cartridge: "Cartridge") -> "ContactBody":  # noqa: F821
+    def from_cartridge(cls, cartridge: "Cartridge") -> "ContactBody":
         """The paper's equivalent body of a cartridge.
 
         * mass: the cartridge's mass;

@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any, Callable, Mapping, Optional, Sequence
 
 from demfem.errors import InvalidParameterError
-from demfem.io import atomic_write_text
+from demfem.io import write_text_atomic
 
 __all__ = ["grid_points", "run_key", "resolve_runner", "sweep", "SweepResult", "parse_grid_option"]
 
@@ -72,7 +72,7 @@ def _run_one(runner_spec: "str | Callable[[dict], dict]", params: dict, path: st
     if not isinstance(result, Mapping):
         raise InvalidParameterError(f"invalid runner result = {result!r}: must be a dict")
     record = {"params": params, "result": dict(result), "wall_time_s": time.perf_counter() - t0}
-    atomic_write_text(path, json.dumps(record, indent=1, default=_json_default))
+    write_text_atomic(path, json.dumps(record, indent=1, default=_json_default))
     return record
 
 
@@ -113,7 +113,7 @@ def _write_table(records: list[dict], path: Path) -> Path:
         row += [str(r["result"].get(k, "")) for k in rkeys]
         row.append(f"{r['wall_time_s']:.3f}")
         lines.append(",".join(row))
-    return atomic_write_text(path, "\n".join(lines) + "\n")
+    return write_text_atomic(path, "\n".join(lines) + "\n")
 
 
 def sweep(

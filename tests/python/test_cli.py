@@ -29,3 +29,17 @@ def test_core_stub_matches_the_extension():
     r = subprocess.run([sys.executable, "-m", "mypy.stubtest", "demfem._core"],
                        capture_output=True, text=True)
     assert r.returncode == 0, r.stdout + r.stderr
+
+
+def test_package_type_checks():
+    """The package is typed (py.typed); mypy must accept it."""
+    import pathlib
+    import subprocess
+    import sys
+
+    import demfem
+
+    pkg = pathlib.Path(demfem.__file__).parent
+    r = subprocess.run([sys.executable, "-m", "mypy", "--ignore-missing-imports", str(pkg)],
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stdout + r.stderr

@@ -4,6 +4,8 @@ import math
 from pathlib import Path
 
 import numpy as np
+
+from demfem.cartridge import Cartridge
 import pytest
 
 from demfem.analysis import (
@@ -33,8 +35,9 @@ def scene(table):
 def test_default_counts_and_arrays(table, scene):
     assert scene.n_particles == 840
     assert scene.positions.shape == (840, 3)
-    assert np.all(scene.radii == 0.0081) and np.all(scene.masses == 0.0049)
-    assert np.all(scene.positions[:, 2] == 0.0081)  # resting on the belt
+    sphere = Cartridge().equivalent_sphere()  # the scene's spheres are the default cartridge's
+    assert np.all(scene.radii == sphere.radius) and np.all(scene.masses == sphere.mass)
+    assert np.all(scene.positions[:, 2] == sphere.radius)  # resting on the belt
     assert scene.tags.shape == (840,) and scene.tags.dtype == np.int32
     assert table.rows_in_rectangle == 20
 
@@ -63,7 +66,7 @@ def test_square_packing_upstream_hexagonal_in_triangle(table, scene):
     tri = ~square
     # Interior spheres: away from walls and from the interface by more than a pitch.
     p = table.pitch
-    inner_square = square & (pos[:, 0] > pos[square, 0].min() + p) & (pos[:, 0] < table.length - p) \
+    inner_square = square & (pos[:, 0] > pos[square, 0].min() + 1.5 * p) & (pos[:, 0] < table.length - p) \
         & (pos[:, 1] > 1.5 * p) & (pos[:, 1] < table.width - 1.5 * p)
     assert inner_square.sum() > 400
     assert np.all(z[inner_square] == 4)
@@ -251,7 +254,7 @@ def write(tmp_path, text):
     ("opening_width = 0.1", r"invalid opening_width = 0.1: must be finite and in \(0, 0.0854"),
     ("tilted_wall_length = 0.5", r"invalid tilted_wall_length = 0.5: must be finite and in "
                                  r"\(0, 0.48\d*\) .*end above the lower side wall"),
-    ("n_spheres = 5000", r"invalid n_spheres = 5000: must be in \[251, 1051\]"),
+    ("n_spheres = 5000", r"invalid n_spheres = 5000: must be in \[252, 1052\]"),
     ("n_spheres = 840.5", r"invalid n_spheres = 840.5: must be a whole number"),
     ("friction = \"high\"", r"invalid friction = 'high': must be a real number"),
     ("planar = 1", r"invalid planar = 1: must be true or false"),
@@ -259,7 +262,7 @@ def write(tmp_path, text):
     ("poisson_ratio = 0.5", r"invalid poisson_ratio = 0.5: must be finite and in \(-1, 0.5\)"),
     ("tilted_wall_angle_deg = 90", r"invalid tilted_wall_angle_deg = 90.0: must be finite and "
                                    r"in \(0, 90\)"),
-    ("wall_height = 0.01", r"invalid wall_height = 0.01: must be finite and in \[0.0162, inf\)"),
+    ("wall_height = 0.01", r"invalid wall_height = 0.01: must be finite and in \[0.0161749, inf\)"),
     ("scene = \"hopper\"", r"invalid scene = 'hopper' in .*bad.toml: must be 'accumulation_table'"),
 ])
 def test_validation_errors_name_field_value_and_range(tmp_path, text, pattern):

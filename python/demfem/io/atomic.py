@@ -13,7 +13,7 @@ from demfem.errors import DemfemIOError
 
 PathLike = Union[str, "os.PathLike[str]"]
 
-__all__ = ["atomic_path", "write_bytes_atomic", "write_text_atomic"]
+__all__ = ["atomic_path", "write_bytes_atomic", "write_text_atomic", "savefig_atomic"]
 
 
 @contextmanager
@@ -26,8 +26,10 @@ def atomic_path(path: PathLike, suffix: str = "") -> Iterator[Path]:
     """
     target = Path(path)
     directory = target.parent if str(target.parent) else Path(".")
-    if not directory.is_dir():
-        raise DemfemIOError(f"i/o error on {target}: directory {directory} does not exist")
+    try:
+        directory.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise DemfemIOError(f"i/o error on {target}: cannot create {directory}: {exc}") from None
     fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp" + suffix,
                                     dir=directory)
     os.close(fd)
@@ -38,6 +40,10 @@ def atomic_path(path: PathLike, suffix: str = "") -> Iterator[Path]:
     os.chmod(tmp, 0o666 & ~umask)
     try:
         yield tmp
+        # flush the content to disk before the rename makes it visible: after a crash the
+        # target is either the old file or the complete new one
+        with open(tmp, "rb") as fh:
+            os.fsync(fh.fileno())
         os.replace(tmp, target)
     except BaseException:
         tmp.unlink(missing_ok=True)
@@ -54,3 +60,11 @@ def write_bytes_atomic(path: PathLike, data: bytes) -> Path:
 def write_text_atomic(path: PathLike, text: str) -> Path:
     """Write UTF-8 ``text`` to ``path`` atomically; return the path."""
     return write_bytes_atomic(path, text.encode("utf-8"))
+
+
+def savefig_atomic(fig, path: PathLike, **kwargs) -> Path:
+    """Save a matplotlib figure to ``path`` atomically (format from the suffix)."""
+    target = Path(path)
+    with atomic_path(target, suffix=target.suffix) as tmp:
+        fig.savefig(tmp, **kwargs)
+    return target

@@ -86,6 +86,10 @@ from scipy.spatial import cKDTree
 
 from demfem.errors import DemfemIOError, InvalidParameterError, check_range
 from demfem.io.atomic import atomic_path, write_text_atomic
+from demfem.materials import PAPER_GLASS
+from demfem.cartridge import Cartridge
+
+_DEFAULT_SPHERE = Cartridge().equivalent_sphere()
 
 __all__ = [
     "AccumulationTable",
@@ -342,8 +346,9 @@ class AccumulationTable:
 
     Attributes:
         n_spheres: number of equivalent spheres at t = 0 (paper: 840).
-        sphere_radius: equivalent-sphere radius, m (paper: diameter about 1.6 cm).
-        sphere_mass: equivalent-sphere mass, kg (the cartridge's mass, about 5 g).
+        sphere_radius: equivalent-sphere radius, m (default: that of the default
+            :class:`demfem.cartridge.Cartridge`, 8.09 mm; paper: diameter about 1.6 cm).
+        sphere_mass: equivalent-sphere mass, kg (default: the default cartridge's, 4.94 g).
         length: length of the rectangular section along the belt (x), m.
         width: width of the table across the belt (y), m.
         tilted_wall_length: length l of the tilted wall, m.
@@ -371,8 +376,8 @@ class AccumulationTable:
     """
 
     n_spheres: int = 840
-    sphere_radius: float = 0.0081
-    sphere_mass: float = 0.0049
+    sphere_radius: float = _DEFAULT_SPHERE.radius
+    sphere_mass: float = _DEFAULT_SPHERE.mass
     length: float = 0.70
     width: float = 0.34
     tilted_wall_length: float = 0.36
@@ -384,9 +389,9 @@ class AccumulationTable:
     gate_phase: float = 0.0
     belt_velocity: float = 0.2
     gravity: float = 9.81
-    young_modulus: float = 45e9
-    poisson_ratio: float = 0.22
-    density: float = 2230.0
+    young_modulus: float = PAPER_GLASS.E
+    poisson_ratio: float = PAPER_GLASS.nu
+    density: float = PAPER_GLASS.density
     friction: float = 0.2
     restitution: float = 0.5
     rolling_resistance: float = 0.0
