@@ -12,7 +12,9 @@ mod neighbor;
 mod record;
 mod scene;
 mod simulation;
+pub mod table;
 
+pub use checkpoint::CHECKPOINT_VERSION;
 pub use effects::{Effect, EffectSet};
 pub use material::{ContactModel, Material, PairLaw};
 pub use record::{ContactOnset, ContactRecord, Frame, Partner};

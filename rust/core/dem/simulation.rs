@@ -663,7 +663,7 @@ impl Simulation {
             onsets: Vec::new(),
             rebuilds: 0,
         };
-        sim.update_wall_state();
+        sim.refresh_wall_state();
         sim.rebuild();
         sim.check_initial_overlaps(scene.initial_overlap_tolerance)?;
         Ok(sim)
@@ -702,11 +702,36 @@ impl Simulation {
         Ok(())
     }
 
-    fn update_wall_state(&mut self) {
+    pub(crate) fn refresh_wall_state(&mut self) {
         let moving = self.effects.has(Effect::MovingWalls);
         for (k, w) in self.walls.iter().enumerate() {
             let (offset, velocity) = if moving { w.motion.offset_and_velocity(self.time) } else { (Vec3::ZERO, Vec3::ZERO) };
             self.wall_state[k] = WallState { offset, velocity };
+        }
+    }
+
+    /// Gather lists (CSR): the pair indices of each particle in increasing order, tagged
+    /// with the side (bit 0: particle is j). A pure function of the pair list.
+    pub(crate) fn build_gather_lists(&mut self) {
+        let n = self.position.len();
+        self.csr_offset.clear();
+        self.csr_offset.resize(n + 1, 0);
+        for p in &self.pairs {
+            self.csr_offset[p.i as usize + 1] += 1;
+            self.csr_offset[p.j as usize + 1] += 1;
+        }
+        for i in 0..n {
+            self.csr_offset[i + 1] += self.csr_offset[i];
+        }
+        self.csr_entry.clear();
+        self.csr_entry.resize(self.csr_offset[n] as usize, 0);
+        let mut fill: Vec<u32> = self.csr_offset[..n].to_vec();
+        for (k, p) in self.pairs.iter().enumerate() {
+            let e = (k as u32) << 1;
+            self.csr_entry[fill[p.i as usize] as usize] = e;
+            fill[p.i as usize] += 1;
+            self.csr_entry[fill[p.j as usize] as usize] = e | 1;
+            fill[p.j as usize] += 1;
         }
     }
 
@@ -730,26 +755,7 @@ impl Simulation {
                 self.pairs.push(PairContact { i, j, ..Default::default() });
             }
         }
-        // ---- gather lists (CSR): pair indices of each particle in increasing order
-        self.csr_offset.clear();
-        self.csr_offset.resize(n + 1, 0);
-        for p in &self.pairs {
-            self.csr_offset[p.i as usize + 1] += 1;
-            self.csr_offset[p.j as usize + 1] += 1;
-        }
-        for i in 0..n {
-            self.csr_offset[i + 1] += self.csr_offset[i];
-        }
-        self.csr_entry.clear();
-        self.csr_entry.resize(self.csr_offset[n] as usize, 0);
-        let mut fill: Vec<u32> = self.csr_offset[..n].to_vec();
-        for (k, p) in self.pairs.iter().enumerate() {
-            let e = (k as u32) << 1;
-            self.csr_entry[fill[p.i as usize] as usize] = e;
-            fill[p.i as usize] += 1;
-            self.csr_entry[fill[p.j as usize] as usize] = e | 1;
-            fill[p.j as usize] += 1;
-        }
+        self.build_gather_lists();
         // ---- wall slots: walls within reach of each particle (the others are skipped)
         std::mem::swap(&mut self.wall_slots, &mut self.old_slots);
         let old_stride = self.wall_stride;
@@ -951,7 +957,7 @@ impl Simulation {
             )));
         }
         if self.effects.has(Effect::MovingWalls) {
-            self.update_wall_state();
+            self.refresh_wall_state();
         }
         let half_skin = 0.5 * self.skin;
         let mut moved = max_disp2 > half_skin * half_skin;
