@@ -62,3 +62,46 @@ impl Rng {
         (z >> 11) as f64 / (1u64 << 53) as f64
     }
 }
+
+/// A jammed monolayer: `nx` × `ny` glass spheres (d = 16 mm) in hexagonal packing with 0.1 %
+/// gap, in a box whose walls touch the packing, on a belt moving at 0.2 m/s towards +x that
+/// presses the pack against the end wall. Effects: gravity, belt, friction, rotation,
+/// damping, planar (upright-cartridge kinematics: the spheres slide on the belt instead of
+/// rolling, so the belt keeps loading the pack with μ m g per sphere; free spheres would end
+/// up spinning in place, which transmits no force, and the pack would relax).
+pub fn jammed_box(nx: usize, ny: usize, young_modulus: f64) -> Scene {
+    use demfem::dem::Effect;
+    let r = 0.008;
+    let pitch = 2.0 * r * 1.001;
+    let row = pitch * 3f64.sqrt() / 2.0;
+    let mut pos = Vec::new();
+    for j in 0..ny {
+        for i in 0..nx {
+            let x = r * 1.001 + i as f64 * pitch + if j % 2 == 1 { pitch / 2.0 } else { 0.0 };
+            pos.push(Vec3::new(x, r * 1.001 + j as f64 * row, r));
+        }
+    }
+    let lx = pos.iter().map(|p| p.x).fold(0.0, f64::max) + r * 1.001;
+    let ly = (ny - 1) as f64 * row + 2.0 * r * 1.001;
+    let n = pos.len();
+    let particles = ParticleInit::at_rest(pos, vec![r; n]);
+    let mut floor = Wall::fixed(WallShape::plane(Vec3::ZERO, Vec3::Z).unwrap(), 0);
+    floor.surface_velocity = Vec3::new(0.2, 0.0, 0.0);
+    let walls = vec![
+        floor,
+        Wall::fixed(WallShape::plane(Vec3::ZERO, Vec3::X).unwrap(), 0),
+        Wall::fixed(WallShape::plane(Vec3::new(lx, 0.0, 0.0), -Vec3::X).unwrap(), 0),
+        Wall::fixed(WallShape::plane(Vec3::ZERO, Vec3::Y).unwrap(), 0),
+        Wall::fixed(WallShape::plane(Vec3::new(0.0, ly, 0.0), -Vec3::Y).unwrap(), 0),
+    ];
+    let glass = Material::new(young_modulus, 0.22, 2230.0, 0.2, 0.5, 0.0);
+    let effects = EffectSet::of(&[
+        Effect::Gravity,
+        Effect::Belt,
+        Effect::Friction,
+        Effect::Rotation,
+        Effect::Damping,
+        Effect::Planar,
+    ]);
+    Scene::new(particles, vec![glass], walls, effects)
+}
