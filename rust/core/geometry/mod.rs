@@ -170,7 +170,7 @@ impl WallShape {
     /// contact pointing from the wall towards `p`, and the signed distance (negative when `p`
     /// is behind a plane or inside a cuboid). Returns `None` when `p` lies exactly on a
     /// two-sided polygon, where no normal is defined.
-    #[inline]
+    #[inline(always)]
     pub fn closest(&self, p: Vec3) -> Option<(Vec3, Vec3, f64)> {
         match self {
             WallShape::Plane { point, normal } => {
@@ -343,7 +343,7 @@ impl Wall {
 
     /// Closest point, outward unit normal (wall → p) and signed distance of `p` to the wall at
     /// displacement `offset`, m.
-    #[inline]
+    #[inline(always)]
     pub fn closest_at(&self, p: Vec3, offset: Vec3) -> Option<(Vec3, Vec3, f64)> {
         self.shape.closest(p - offset).map(|(q, n, d)| (q + offset, n, d))
     }
