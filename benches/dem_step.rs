@@ -44,7 +44,9 @@ fn packed_scene() -> (Scene, Vec<u8>) {
 fn bench_threads(c: &mut Criterion, bytes: &[u8]) {
     let mut g = c.benchmark_group("anchor_table_packed_45GPa");
     g.throughput(Throughput::Elements(840 * STEPS_PER_ITER));
-    g.sample_size(10).warm_up_time(Duration::from_secs(1)).measurement_time(Duration::from_secs(4));
+    g.sample_size(10)
+        .warm_up_time(Duration::from_secs(1))
+        .measurement_time(Duration::from_secs(4));
     for threads in [1usize, 2] {
         // restore the exact packed state (history included) rather than the copied initial data
         let mut sim = {
@@ -54,10 +56,13 @@ fn bench_threads(c: &mut Criterion, bytes: &[u8]) {
             }
             fresh.threads = threads;
             let mut sim = Simulation::new(&fresh).expect("simulation");
-            sim.restore_checkpoint_bytes(bytes, "packed").expect("restore");
+            sim.restore_checkpoint_bytes(bytes, "packed")
+                .expect("restore");
             sim
         };
-        g.bench_function(format!("threads_{threads}"), |b| b.iter(|| sim.step(STEPS_PER_ITER).expect("step")));
+        g.bench_function(format!("threads_{threads}"), |b| {
+            b.iter(|| sim.step(STEPS_PER_ITER).expect("step"))
+        });
     }
     g.finish();
 }
@@ -65,37 +70,63 @@ fn bench_threads(c: &mut Criterion, bytes: &[u8]) {
 fn bench_effects(c: &mut Criterion, scene: &Scene) {
     let mut g = c.benchmark_group("effect_cost_1_thread");
     g.throughput(Throughput::Elements(840 * STEPS_PER_ITER));
-    g.sample_size(10).warm_up_time(Duration::from_millis(500)).measurement_time(Duration::from_secs(2));
+    g.sample_size(10)
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(2));
     let variants: Vec<(&str, Box<dyn Fn(&mut Scene)>)> = vec![
         ("all_table_effects", Box::new(|_s: &mut Scene| {})),
-        ("without_rotation", Box::new(|s: &mut Scene| {
-            s.effects = s.effects.without(Effect::Rotation);
-            s.particles.angular_velocity.iter_mut().for_each(|w| *w = Vec3::ZERO);
-        })),
-        ("without_friction", Box::new(|s: &mut Scene| {
-            s.effects = s.effects.without(Effect::Friction);
-            s.materials[0].friction = 0.0;
-        })),
-        ("without_damping", Box::new(|s: &mut Scene| {
-            s.effects = s.effects.without(Effect::Damping);
-            s.materials[0].restitution = 1.0;
-        })),
-        ("without_belt", Box::new(|s: &mut Scene| {
-            s.effects = s.effects.without(Effect::Belt);
-            s.walls[0].surface_velocity = Vec3::ZERO;
-        })),
-        ("plus_planar", Box::new(|s: &mut Scene| {
-            s.effects = s.effects.with(Effect::Planar);
-            s.particles.angular_velocity.iter_mut().for_each(|w| {
-                w.x = 0.0;
-                w.y = 0.0
-            });
-        })),
-        ("plus_rolling_resistance", Box::new(|s: &mut Scene| {
-            s.effects = s.effects.with(Effect::RollingResistance);
-            s.materials[0].rolling_friction = 0.01;
-        })),
-        ("plus_onset_log", Box::new(|s: &mut Scene| s.record_onsets = true)),
+        (
+            "without_rotation",
+            Box::new(|s: &mut Scene| {
+                s.effects = s.effects.without(Effect::Rotation);
+                s.particles
+                    .angular_velocity
+                    .iter_mut()
+                    .for_each(|w| *w = Vec3::ZERO);
+            }),
+        ),
+        (
+            "without_friction",
+            Box::new(|s: &mut Scene| {
+                s.effects = s.effects.without(Effect::Friction);
+                s.materials[0].friction = 0.0;
+            }),
+        ),
+        (
+            "without_damping",
+            Box::new(|s: &mut Scene| {
+                s.effects = s.effects.without(Effect::Damping);
+                s.materials[0].restitution = 1.0;
+            }),
+        ),
+        (
+            "without_belt",
+            Box::new(|s: &mut Scene| {
+                s.effects = s.effects.without(Effect::Belt);
+                s.walls[0].surface_velocity = Vec3::ZERO;
+            }),
+        ),
+        (
+            "plus_planar",
+            Box::new(|s: &mut Scene| {
+                s.effects = s.effects.with(Effect::Planar);
+                s.particles.angular_velocity.iter_mut().for_each(|w| {
+                    w.x = 0.0;
+                    w.y = 0.0
+                });
+            }),
+        ),
+        (
+            "plus_rolling_resistance",
+            Box::new(|s: &mut Scene| {
+                s.effects = s.effects.with(Effect::RollingResistance);
+                s.materials[0].rolling_friction = 0.01;
+            }),
+        ),
+        (
+            "plus_onset_log",
+            Box::new(|s: &mut Scene| s.record_onsets = true),
+        ),
     ];
     for (name, change) in variants {
         let mut s = scene.clone();

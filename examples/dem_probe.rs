@@ -4,7 +4,10 @@ mod dem_support;
 use demfem::dem::Simulation;
 fn main() {
     let mut scene = dem_support::jammed_box(10, 8, 73e9);
-    let f: f64 = std::env::args().nth(1).map(|a| a.parse().unwrap()).unwrap_or(0.2);
+    let f: f64 = std::env::args()
+        .nth(1)
+        .map(|a| a.parse().unwrap())
+        .unwrap_or(0.2);
     let lim = Simulation::new(&scene).unwrap().stable_step().limit;
     scene.time_step = Some(f * lim);
     let mut sim = Simulation::new(&scene).unwrap();

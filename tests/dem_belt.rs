@@ -12,7 +12,13 @@ use demfem::geometry::Vec3;
 fn belt_scene(planar: bool) -> Simulation {
     let r = 0.008;
     let glass = material(45e9, 0.22, 2230.0, 0.2, 0.5);
-    let mut effects = EffectSet::of(&[Effect::Gravity, Effect::Belt, Effect::Friction, Effect::Rotation, Effect::Damping]);
+    let mut effects = EffectSet::of(&[
+        Effect::Gravity,
+        Effect::Belt,
+        Effect::Friction,
+        Effect::Rotation,
+        Effect::Damping,
+    ]);
     if planar {
         effects = effects.with(Effect::Planar);
     }

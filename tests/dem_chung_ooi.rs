@@ -41,9 +41,20 @@ fn test1_elastic_sphere_sphere_matches_hertz() {
     let (e, nu, rho, r, v) = (4.8e10, 0.20, 2800.0, 0.010, 10.0);
     let m = sphere_mass(rho, r);
     let (d_th, f_th, t_th) = hertz_impact(e_star(e, nu, e, nu), r / 2.0, m / 2.0, 2.0 * v);
-    let mut p = ParticleInit::at_rest(vec![Vec3::new(-r - 1e-5, 0.0, 0.0), Vec3::new(r + 1e-5, 0.0, 0.0)], vec![r, r]);
+    let mut p = ParticleInit::at_rest(
+        vec![
+            Vec3::new(-r - 1e-5, 0.0, 0.0),
+            Vec3::new(r + 1e-5, 0.0, 0.0),
+        ],
+        vec![r, r],
+    );
     p.velocity = vec![Vec3::new(v, 0.0, 0.0), Vec3::new(-v, 0.0, 0.0)];
-    let mut scene = Scene::new(p, vec![material(e, nu, rho, 0.0, 1.0)], vec![], EffectSet::empty());
+    let mut scene = Scene::new(
+        p,
+        vec![material(e, nu, rho, 0.0, 1.0)],
+        vec![],
+        EffectSet::empty(),
+    );
     scene.gravity = Vec3::ZERO;
     scene.expected_max_speed = 2.0 * v;
     scene.time_step = Some(t_th / 1000.0);
@@ -51,7 +62,10 @@ fn test1_elastic_sphere_sphere_matches_hertz() {
     let (d, f, t, _) = track_contact(&mut sim, 10_000);
     assert!((d / d_th - 1.0).abs() < 3e-3, "overlap {d} vs Hertz {d_th}");
     assert!((f / f_th - 1.0).abs() < 3e-3, "force {f} vs Hertz {f_th}");
-    assert!((t / t_th - 1.0).abs() < 3e-3, "duration {t} vs Hertz {t_th}");
+    assert!(
+        (t / t_th - 1.0).abs() < 3e-3,
+        "duration {t} vs Hertz {t_th}"
+    );
 }
 
 /// Test 2: elastic normal impact of a sphere (R = 0.1 m) on a rigid plane at 0.2 m/s, for
@@ -64,13 +78,26 @@ fn test2_elastic_sphere_wall_matches_hertz() {
         let m = sphere_mass(rho, r);
         let (d_th, f_th, t_th) = hertz_impact(e_star(e, nu, 1e21, nu), r, m, v);
         let mats = vec![material(e, nu, rho, 0.0, 1.0), rigid(nu, 0.0, 1.0)];
-        let mut scene = sphere_on_floor(r, r + 1e-7, Vec3::new(0.0, 0.0, -v), Vec3::ZERO, mats, EffectSet::empty());
+        let mut scene = sphere_on_floor(
+            r,
+            r + 1e-7,
+            Vec3::new(0.0, 0.0, -v),
+            Vec3::ZERO,
+            mats,
+            EffectSet::empty(),
+        );
         scene.time_step = Some(t_th / 1000.0);
         let mut sim = Simulation::new(&scene).unwrap();
         let (d, f, t, _) = track_contact(&mut sim, 10_000);
-        assert!((d / d_th - 1.0).abs() < 3e-3, "E={e}: overlap {d} vs {d_th}");
+        assert!(
+            (d / d_th - 1.0).abs() < 3e-3,
+            "E={e}: overlap {d} vs {d_th}"
+        );
         assert!((f / f_th - 1.0).abs() < 3e-3, "E={e}: force {f} vs {f_th}");
-        assert!((t / t_th - 1.0).abs() < 3e-3, "E={e}: duration {t} vs {t_th}");
+        assert!(
+            (t / t_th - 1.0).abs() < 3e-3,
+            "E={e}: duration {t} vs {t_th}"
+        );
         // undamped and frictionless: the rebound speed equals the impact speed
         let v_out = sim.velocities()[0].z;
         assert!((v_out / v - 1.0).abs() < 1e-6, "E={e}: rebound {v_out}");
@@ -90,7 +117,14 @@ fn test3_restitution_is_realised_with_and_without_clamp() {
         for k in 1..=9 {
             let e = k as f64 / 10.0;
             let mats = vec![material(e_mod, nu, rho, 0.0, e), rigid(nu, 0.0, e)];
-            let mut scene = sphere_on_floor(r, r + 1e-7, Vec3::new(0.0, 0.0, -v), Vec3::ZERO, mats, EffectSet::of(&[Effect::Damping]));
+            let mut scene = sphere_on_floor(
+                r,
+                r + 1e-7,
+                Vec3::new(0.0, 0.0, -v),
+                Vec3::ZERO,
+                mats,
+                EffectSet::of(&[Effect::Damping]),
+            );
             scene.clamp_normal_force = clamp;
             scene.time_step = Some(t_th / 2000.0);
             let mut sim = Simulation::new(&scene).unwrap();
@@ -105,7 +139,10 @@ fn test3_restitution_is_realised_with_and_without_clamp() {
                 }
             }
             let e_real = sim.velocities()[0].z / v;
-            assert!((e_real / e - 1.0).abs() < 0.01, "clamp={clamp}: e = {e}, realised {e_real}");
+            assert!(
+                (e_real / e - 1.0).abs() < 0.01,
+                "clamp={clamp}: e = {e}, realised {e_real}"
+            );
         }
     }
 }
@@ -128,7 +165,14 @@ fn test4_oblique_impact_matches_rigid_body_theory_when_sliding() {
         let th = deg.to_radians();
         let (vt, vn) = (speed * th.sin(), speed * th.cos());
         let mats = vec![material(e_mod, nu, rho, mu, e), rigid(nu, mu, e)];
-        let mut scene = sphere_on_floor(r, r + 1e-8, Vec3::new(vt, 0.0, -vn), Vec3::ZERO, mats, effects);
+        let mut scene = sphere_on_floor(
+            r,
+            r + 1e-8,
+            Vec3::new(vt, 0.0, -vn),
+            Vec3::ZERO,
+            mats,
+            effects,
+        );
         scene.expected_max_speed = speed;
         scene.time_step = Some(t_th / 1500.0);
         let mut sim = Simulation::new(&scene).unwrap();
@@ -145,24 +189,47 @@ fn test4_oblique_impact_matches_rigid_body_theory_when_sliding() {
         let v_out = sim.velocities()[0];
         let w_out = sim.angular_velocities()[0];
         let vn_out = v_out.z;
-        assert!((vn_out / (e * vn) - 1.0).abs() < 0.01, "{deg}°: normal rebound {vn_out} vs {}", e * vn);
+        assert!(
+            (vn_out / (e * vn) - 1.0).abs() < 0.01,
+            "{deg}°: normal rebound {vn_out} vs {}",
+            e * vn
+        );
         assert!(sim.kinetic_energy() <= ke0, "{deg}°: energy gained");
         if th.tan() > 1.1 * limit_tan {
             let vt_th = vt - mu * (1.0 + e) * vn;
             let w_th = 2.5 * mu * (1.0 + e) * vn / r;
-            assert!((v_out.x / vt_th - 1.0).abs() < 0.01, "{deg}°: v_t {} vs {vt_th}", v_out.x);
+            assert!(
+                (v_out.x / vt_th - 1.0).abs() < 0.01,
+                "{deg}°: v_t {} vs {vt_th}",
+                v_out.x
+            );
             // a sphere sliding in +x on a floor below spins about +y
-            assert!((w_out.y / w_th - 1.0).abs() < 0.01, "{deg}°: ω {} vs {w_th}", w_out.y);
+            assert!(
+                (w_out.y / w_th - 1.0).abs() < 0.01,
+                "{deg}°: ω {} vs {w_th}",
+                w_out.y
+            );
         }
         // any regime: the Coulomb bound on the tangential impulse, |Δv_t| ≤ μ (1+e) v_n
         // (1 % for the realised e), and angular momentum about the contact point is conserved,
         // so I Δω = m R Δv_t, i.e. ω = 5/2 Δv_t / R (the lever arm R − δ differs by δ/R < 1e-3)
         let dvt = vt - v_out.x;
-        assert!(dvt <= 1.01 * mu * (1.0 + e) * vn && dvt >= 0.0, "{deg}°: Δv_t {dvt}");
-        assert!((w_out.y / (2.5 * dvt / r) - 1.0).abs() < 1e-2, "{deg}°: ω {} vs {}", w_out.y, 2.5 * dvt / r);
+        assert!(
+            dvt <= 1.01 * mu * (1.0 + e) * vn && dvt >= 0.0,
+            "{deg}°: Δv_t {dvt}"
+        );
+        assert!(
+            (w_out.y / (2.5 * dvt / r) - 1.0).abs() < 1e-2,
+            "{deg}°: ω {} vs {}",
+            w_out.y,
+            2.5 * dvt / r
+        );
         // the contact point's tangential velocity never grows in magnitude (no energy gain)
         let slip_out = v_out.x - w_out.y * r;
-        assert!(slip_out.abs() <= vt * 1.0001, "{deg}°: contact-point velocity {slip_out} vs incident {vt}");
+        assert!(
+            slip_out.abs() <= vt * 1.0001,
+            "{deg}°: contact-point velocity {slip_out} vs incident {vt}"
+        );
     }
 }
 
@@ -181,7 +248,12 @@ fn undamped_impacts_conserve_energy() {
             vec![r, r],
         );
         p.velocity = vec![Vec3::new(v, 0.0, 0.0), Vec3::ZERO];
-        let mut scene = Scene::new(p, vec![material(e, nu, rho, 0.0, 1.0)], vec![], EffectSet::empty());
+        let mut scene = Scene::new(
+            p,
+            vec![material(e, nu, rho, 0.0, 1.0)],
+            vec![],
+            EffectSet::empty(),
+        );
         scene.gravity = Vec3::ZERO;
         scene.expected_max_speed = v;
         scene.time_step = Some(t_th / 2000.0);

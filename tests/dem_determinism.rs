@@ -7,7 +7,12 @@ use demfem::dem::Simulation;
 
 fn bits(sim: &Simulation) -> Vec<u64> {
     let mut out = Vec::new();
-    for v in sim.positions().iter().chain(sim.velocities()).chain(sim.angular_velocities()) {
+    for v in sim
+        .positions()
+        .iter()
+        .chain(sim.velocities())
+        .chain(sim.angular_velocities())
+    {
         out.extend([v.x.to_bits(), v.y.to_bits(), v.z.to_bits()]);
     }
     out
@@ -28,7 +33,11 @@ fn one_and_two_threads_are_bitwise_identical() {
     let mut b = packed_soft(2);
     a.step(3000).unwrap();
     b.step(3000).unwrap();
-    assert!(a.contacts().len() > 500, "the test needs many contacts: {}", a.contacts().len());
+    assert!(
+        a.contacts().len() > 500,
+        "the test needs many contacts: {}",
+        a.contacts().len()
+    );
     assert_eq!(bits(&a), bits(&b));
     assert_eq!(a.onsets(), b.onsets());
     assert_eq!(a.onsets().is_empty(), false);
@@ -50,8 +59,14 @@ fn restart_from_checkpoint_is_bitwise_identical() {
     restarted.step(1500).unwrap();
     assert_eq!(bits(&reference), bits(&restarted));
     // the history survived: some contact is sticking with a non-zero tangential force
-    assert!(restarted.contacts().iter().any(|c| c.tangential_force.length() > 0.0));
-    assert!(!path.with_extension("ck.tmp").exists(), "temp file left behind");
+    assert!(restarted
+        .contacts()
+        .iter()
+        .any(|c| c.tangential_force.length() > 0.0));
+    assert!(
+        !path.with_extension("ck.tmp").exists(),
+        "temp file left behind"
+    );
 
     // a checkpoint from another scene is refused
     let mut other_scene = anchor_scene(2e8, TableStart::PackedIntoFunnel).unwrap();

@@ -41,7 +41,10 @@ fn data_needing_an_unnamed_effect_is_refused() {
     let mut s = base.clone();
     s.effects = s.effects.with(Effect::RollingResistance);
     assert!(effect_err(&s).contains("rolling"));
-    assert!(matches!(EffectSet::parse(&["gravity", "wind"]), Err(DemfemError::Effect(_))));
+    assert!(matches!(
+        EffectSet::parse(&["gravity", "wind"]),
+        Err(DemfemError::Effect(_))
+    ));
 }
 
 #[test]
@@ -56,22 +59,40 @@ fn bad_input_is_an_error_naming_the_culprit() {
     }
     let mut s = base.clone();
     s.particles.position[3].y = f64::NAN;
-    assert!(matches!(Simulation::new(&s), Err(DemfemError::InvalidParameter { .. })));
+    assert!(matches!(
+        Simulation::new(&s),
+        Err(DemfemError::InvalidParameter { .. })
+    ));
     let mut s = base.clone();
     s.materials[0].poisson_ratio = 0.5;
-    assert!(matches!(Simulation::new(&s), Err(DemfemError::InvalidParameter { .. })));
+    assert!(matches!(
+        Simulation::new(&s),
+        Err(DemfemError::InvalidParameter { .. })
+    ));
     let mut s = base.clone();
     s.materials[0].young_modulus = 0.0;
-    assert!(matches!(Simulation::new(&s), Err(DemfemError::InvalidParameter { .. })));
+    assert!(matches!(
+        Simulation::new(&s),
+        Err(DemfemError::InvalidParameter { .. })
+    ));
     let mut s = base.clone();
     s.particles.radius.pop();
-    assert!(matches!(Simulation::new(&s), Err(DemfemError::ShapeMismatch { .. })));
+    assert!(matches!(
+        Simulation::new(&s),
+        Err(DemfemError::ShapeMismatch { .. })
+    ));
     let mut s = base.clone();
     s.particles.material[0] = 5;
-    assert!(matches!(Simulation::new(&s), Err(DemfemError::InvalidParameter { .. })));
+    assert!(matches!(
+        Simulation::new(&s),
+        Err(DemfemError::InvalidParameter { .. })
+    ));
     let mut s = base.clone();
     s.time_step = Some(-1.0);
-    assert!(matches!(Simulation::new(&s), Err(DemfemError::InvalidParameter { .. })));
+    assert!(matches!(
+        Simulation::new(&s),
+        Err(DemfemError::InvalidParameter { .. })
+    ));
 }
 
 /// Without `friction` no tangential force exists; without `rotation` no spin develops.
@@ -98,7 +119,10 @@ fn planar_keeps_one_layer() {
     sim.step(4000).unwrap();
     assert_eq!(sim.riding_up_count(0.0, 1e-4), 0);
     let r = 0.008;
-    assert!(sim.positions().iter().all(|p| (p.z - r).abs() < 1e-4), "layer left");
+    assert!(
+        sim.positions().iter().all(|p| (p.z - r).abs() < 1e-4),
+        "layer left"
+    );
 }
 
 /// Every new contact is logged once with its impact velocities: a sphere dropped at 0.3 m/s
@@ -106,7 +130,14 @@ fn planar_keeps_one_layer() {
 #[test]
 fn contact_onsets_are_logged_with_impact_velocity() {
     let glass = material(45e9, 0.22, 2230.0, 0.0, 0.5);
-    let mut s = sphere_on_floor(0.008, 0.008 + 1e-6, Vec3::new(0.0, 0.0, -0.3), Vec3::ZERO, vec![glass, glass], EffectSet::of(&[Effect::Damping]));
+    let mut s = sphere_on_floor(
+        0.008,
+        0.008 + 1e-6,
+        Vec3::new(0.0, 0.0, -0.3),
+        Vec3::ZERO,
+        vec![glass, glass],
+        EffectSet::of(&[Effect::Damping]),
+    );
     s.record_onsets = true;
     s.record_every = 100;
     let mut sim = Simulation::new(&s).unwrap();
@@ -115,11 +146,17 @@ fn contact_onsets_are_logged_with_impact_velocity() {
     assert_eq!(onsets.len(), 1, "{onsets:?}");
     let o = onsets[0];
     assert_eq!(o.partner, Partner::Wall(0));
-    assert!((o.normal_speed - 0.3).abs() < 1e-9 && o.tangential_speed < 1e-12, "{o:?}");
+    assert!(
+        (o.normal_speed - 0.3).abs() < 1e-9 && o.tangential_speed < 1e-12,
+        "{o:?}"
+    );
     assert!(o.time > 0.0 && (o.partner_position.z).abs() < 1e-12);
     assert_eq!(sim.frames().len(), 20);
     // two spheres: one particle–particle onset naming both
-    let mut p = ParticleInit::at_rest(vec![Vec3::ZERO, Vec3::new(0.016 + 1e-6, 0.0, 0.0)], vec![0.008, 0.008]);
+    let mut p = ParticleInit::at_rest(
+        vec![Vec3::ZERO, Vec3::new(0.016 + 1e-6, 0.0, 0.0)],
+        vec![0.008, 0.008],
+    );
     p.velocity[0] = Vec3::new(0.2, 0.05, 0.0);
     let mut s = Scene::new(p, vec![glass], vec![], EffectSet::of(&[Effect::Damping]));
     s.gravity = Vec3::ZERO;
@@ -128,5 +165,8 @@ fn contact_onsets_are_logged_with_impact_velocity() {
     sim.step(2000).unwrap();
     let o = sim.onsets()[0];
     assert_eq!((o.particle, o.partner), (0, Partner::Particle(1)));
-    assert!((o.normal_speed - 0.2).abs() < 2e-3 && (o.tangential_speed - 0.05).abs() < 2e-3, "{o:?}");
+    assert!(
+        (o.normal_speed - 0.2).abs() < 2e-3 && (o.tangential_speed - 0.05).abs() < 2e-3,
+        "{o:?}"
+    );
 }

@@ -17,12 +17,18 @@ fn run_jammed(scene: &Scene, steps: u64) {
     let mut sim = Simulation::new(scene).unwrap();
     let r = 0.008;
     let n = sim.len() as f64;
-    let ke_cap = 1.05 * n * (0.5 * sim.masses()[0] * 0.2 * 0.2 + 0.5 * sim.inertias()[0] * (0.2 / r) * (0.2 / r));
+    let ke_cap = 1.05
+        * n
+        * (0.5 * sim.masses()[0] * 0.2 * 0.2 + 0.5 * sim.inertias()[0] * (0.2 / r) * (0.2 / r));
     let mut max_overlap: f64 = 0.0;
     for _ in 0..steps / 1000 {
         sim.step(1000).unwrap();
         max_overlap = max_overlap.max(sim.max_overlap());
-        assert!(sim.kinetic_energy() < ke_cap, "KE {} > {ke_cap}", sim.kinetic_energy());
+        assert!(
+            sim.kinetic_energy() < ke_cap,
+            "KE {} > {ke_cap}",
+            sim.kinetic_energy()
+        );
     }
     assert!(max_overlap < 0.01 * r, "overlap {max_overlap}");
     // the pack really is jammed: a hexagonal monolayer pressed by the belt has Z ≈ 3-4 at the end
@@ -61,7 +67,10 @@ fn fast_impact_on_thin_wall_does_not_tunnel() {
     let glass = material(e, 0.22, 2230.0, 0.0, 1.0);
     let mut p = ParticleInit::at_rest(vec![Vec3::new(-r - 1e-4, 0.0, 0.0)], vec![r]);
     p.velocity[0] = Vec3::new(v, 0.0, 0.0);
-    let leaf = Wall::fixed(WallShape::vertical_strip(0.0, -0.05, 0.0, 0.05, -0.05, 0.05).unwrap(), 0);
+    let leaf = Wall::fixed(
+        WallShape::vertical_strip(0.0, -0.05, 0.0, 0.05, -0.05, 0.05).unwrap(),
+        0,
+    );
     let mut scene = Scene::new(p, vec![glass], vec![leaf], EffectSet::empty());
     scene.gravity = Vec3::ZERO;
     scene.expected_max_speed = v;
@@ -74,8 +83,15 @@ fn fast_impact_on_thin_wall_does_not_tunnel() {
         d_max = d_max.max(sim.max_overlap());
         assert!(sim.positions()[0].x < 0.0, "centre crossed the wall");
     }
-    assert!(sim.velocities()[0].x < -0.99 * v, "no rebound: {:?}", sim.velocities()[0]);
-    assert!((d_max / d_th - 1.0).abs() < 0.02, "overlap {d_max} vs Hertz {d_th}");
+    assert!(
+        sim.velocities()[0].x < -0.99 * v,
+        "no rebound: {:?}",
+        sim.velocities()[0]
+    );
+    assert!(
+        (d_max / d_th - 1.0).abs() < 0.02,
+        "overlap {d_max} vs Hertz {d_th}"
+    );
 }
 
 /// A sphere between a fixed wall (x = 0) and a gate oscillating along x with A = 1 mm,
@@ -91,9 +107,17 @@ fn sphere_wedged_by_oscillating_gate_stays_bounded() {
     let glass = material(45e9, 0.22, 2230.0, 0.2, 0.5);
     let p = ParticleInit::at_rest(vec![Vec3::new(r, 0.0, 0.0)], vec![r]);
     let fixed = Wall::fixed(WallShape::plane(Vec3::ZERO, Vec3::X).unwrap(), 0);
-    let mut gate = Wall::fixed(WallShape::vertical_strip(gate_x, -0.05, gate_x, 0.05, -0.05, 0.05).unwrap(), 0);
+    let mut gate = Wall::fixed(
+        WallShape::vertical_strip(gate_x, -0.05, gate_x, 0.05, -0.05, 0.05).unwrap(),
+        0,
+    );
     gate.motion = WallMotion::harmonic(-Vec3::X, amp, period, 0.0).unwrap();
-    let effects = EffectSet::of(&[Effect::MovingWalls, Effect::Friction, Effect::Rotation, Effect::Damping]);
+    let effects = EffectSet::of(&[
+        Effect::MovingWalls,
+        Effect::Friction,
+        Effect::Rotation,
+        Effect::Damping,
+    ]);
     let mut scene = Scene::new(p, vec![glass], vec![fixed, gate], effects);
     scene.gravity = Vec3::ZERO;
     scene.expected_max_speed = 2.0;
@@ -105,7 +129,14 @@ fn sphere_wedged_by_oscillating_gate_stays_bounded() {
         d_max = d_max.max(sim.max_overlap());
         let x = sim.positions()[0].x;
         assert!(x > 0.0 && x < gate_x + amp, "escaped: x = {x}");
-        assert!(sim.velocities()[0].length() < 5.0, "speed {:?}", sim.velocities()[0]);
+        assert!(
+            sim.velocities()[0].length() < 5.0,
+            "speed {:?}",
+            sim.velocities()[0]
+        );
     }
-    assert!(d_max > 0.0 && d_max < 1.1 * squeeze, "overlap {d_max} vs squeeze {squeeze}");
+    assert!(
+        d_max > 0.0 && d_max < 1.1 * squeeze,
+        "overlap {d_max} vs squeeze {squeeze}"
+    );
 }

@@ -40,7 +40,14 @@ pub fn rigid(nu: f64, mu: f64, rest: f64) -> Material {
 }
 
 /// One sphere of radius r above the floor plane z = 0 at height z, velocity v.
-pub fn sphere_on_floor(r: f64, z: f64, v: Vec3, w: Vec3, mats: Vec<Material>, effects: EffectSet) -> Scene {
+pub fn sphere_on_floor(
+    r: f64,
+    z: f64,
+    v: Vec3,
+    w: Vec3,
+    mats: Vec<Material>,
+    effects: EffectSet,
+) -> Scene {
     let mut p = ParticleInit::at_rest(vec![Vec3::new(0.0, 0.0, z)], vec![r]);
     p.velocity[0] = v;
     p.angular_velocity[0] = w;
@@ -90,9 +97,15 @@ pub fn jammed_box(nx: usize, ny: usize, young_modulus: f64) -> Scene {
     let walls = vec![
         floor,
         Wall::fixed(WallShape::plane(Vec3::ZERO, Vec3::X).unwrap(), 0),
-        Wall::fixed(WallShape::plane(Vec3::new(lx, 0.0, 0.0), -Vec3::X).unwrap(), 0),
+        Wall::fixed(
+            WallShape::plane(Vec3::new(lx, 0.0, 0.0), -Vec3::X).unwrap(),
+            0,
+        ),
         Wall::fixed(WallShape::plane(Vec3::ZERO, Vec3::Y).unwrap(), 0),
-        Wall::fixed(WallShape::plane(Vec3::new(0.0, ly, 0.0), -Vec3::Y).unwrap(), 0),
+        Wall::fixed(
+            WallShape::plane(Vec3::new(0.0, ly, 0.0), -Vec3::Y).unwrap(),
+            0,
+        ),
     ];
     let glass = Material::new(young_modulus, 0.22, 2230.0, 0.2, 0.5, 0.0);
     let effects = EffectSet::of(&[

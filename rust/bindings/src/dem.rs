@@ -15,7 +15,11 @@ use demfem::DemfemError;
 use crate::{CoreResult, PyDemfemError};
 
 fn shape_err(field: &str, detail: String) -> PyErr {
-    PyDemfemError::from(DemfemError::ShapeMismatch { field: field.into(), detail }).into()
+    PyDemfemError::from(DemfemError::ShapeMismatch {
+        field: field.into(),
+        detail,
+    })
+    .into()
 }
 
 fn invalid(field: &str, value: &str, allowed: &str) -> PyErr {
@@ -31,14 +35,26 @@ fn vec3s(field: &str, a: &PyReadonlyArray2<'_, f64>, n: Option<usize>) -> PyResu
     let v = a.as_array();
     let s = v.shape();
     if s[1] != 3 || n.is_some_and(|n| n != s[0]) {
-        return Err(shape_err(field, format!("expected ({}, 3), got ({}, {})", n.map_or("N".into(), |n| n.to_string()), s[0], s[1])));
+        return Err(shape_err(
+            field,
+            format!(
+                "expected ({}, 3), got ({}, {})",
+                n.map_or("N".into(), |n| n.to_string()),
+                s[0],
+                s[1]
+            ),
+        ));
     }
-    Ok(v.outer_iter().map(|r| Vec3::new(r[0], r[1], r[2])).collect())
+    Ok(v.outer_iter()
+        .map(|r| Vec3::new(r[0], r[1], r[2]))
+        .collect())
 }
 
 fn get_f64(d: &Bound<'_, PyDict>, key: &str, default: Option<f64>, what: &str) -> PyResult<f64> {
     match d.get_item(key)? {
-        Some(v) => v.extract::<f64>().map_err(|_| invalid(&format!("{what}.{key}"), &v.to_string(), "a number")),
+        Some(v) => v
+            .extract::<f64>()
+            .map_err(|_| invalid(&format!("{what}.{key}"), &v.to_string(), "a number")),
         None => default.ok_or_else(|| invalid(&format!("{what}.{key}"), "missing", "required")),
     }
 }
@@ -46,9 +62,14 @@ fn get_f64(d: &Bound<'_, PyDict>, key: &str, default: Option<f64>, what: &str) -
 fn get_vec3(d: &Bound<'_, PyDict>, key: &str, default: Option<Vec3>, what: &str) -> PyResult<Vec3> {
     match d.get_item(key)? {
         Some(v) => {
-            let x: Vec<f64> = v.extract().map_err(|_| invalid(&format!("{what}.{key}"), &v.to_string(), "3 numbers"))?;
+            let x: Vec<f64> = v
+                .extract()
+                .map_err(|_| invalid(&format!("{what}.{key}"), &v.to_string(), "3 numbers"))?;
             if x.len() != 3 {
-                return Err(shape_err(&format!("{what}.{key}"), format!("expected 3 components, got {}", x.len())));
+                return Err(shape_err(
+                    &format!("{what}.{key}"),
+                    format!("expected 3 components, got {}", x.len()),
+                ));
             }
             Ok(Vec3::new(x[0], x[1], x[2]))
         }
@@ -73,10 +94,19 @@ fn parse_wall(d: &Bound<'_, PyDict>, k: usize) -> PyResult<Wall> {
     let w = format!("walls[{k}]");
     let kind: String = match d.get_item("type")? {
         Some(t) => t.extract()?,
-        None => return Err(invalid(&format!("{w}.type"), "missing", "'plane', 'polygon', 'strip' or 'cuboid'")),
+        None => {
+            return Err(invalid(
+                &format!("{w}.type"),
+                "missing",
+                "'plane', 'polygon', 'strip' or 'cuboid'",
+            ))
+        }
     };
     let shape = match kind.as_str() {
-        "plane" => WallShape::plane(get_vec3(d, "point", None, &w)?, get_vec3(d, "normal", None, &w)?),
+        "plane" => WallShape::plane(
+            get_vec3(d, "point", None, &w)?,
+            get_vec3(d, "normal", None, &w)?,
+        ),
         "polygon" => {
             let verts: Vec<Vec<f64>> = match d.get_item("vertices")? {
                 Some(v) => v.extract()?,
@@ -85,7 +115,10 @@ fn parse_wall(d: &Bound<'_, PyDict>, k: usize) -> PyResult<Wall> {
             let mut out = Vec::with_capacity(verts.len());
             for v in verts {
                 if v.len() != 3 {
-                    return Err(shape_err(&format!("{w}.vertices"), format!("vertex with {} components", v.len())));
+                    return Err(shape_err(
+                        &format!("{w}.vertices"),
+                        format!("vertex with {} components", v.len()),
+                    ));
                 }
                 out.push(Vec3::new(v[0], v[1], v[2]));
             }
@@ -99,23 +132,42 @@ fn parse_wall(d: &Bound<'_, PyDict>, k: usize) -> PyResult<Wall> {
             get_f64(d, "z_bottom", None, &w)?,
             get_f64(d, "z_top", None, &w)?,
         ),
-        "cuboid" => WallShape::cuboid(get_vec3(d, "center", None, &w)?, get_vec3(d, "half_extents", None, &w)?),
-        other => return Err(invalid(&format!("{w}.type"), other, "'plane', 'polygon', 'strip' or 'cuboid'")),
+        "cuboid" => WallShape::cuboid(
+            get_vec3(d, "center", None, &w)?,
+            get_vec3(d, "half_extents", None, &w)?,
+        ),
+        other => {
+            return Err(invalid(
+                &format!("{w}.type"),
+                other,
+                "'plane', 'polygon', 'strip' or 'cuboid'",
+            ))
+        }
     }
     .map_err(PyDemfemError::from)?;
     let motion = match d.get_item("motion")? {
         None => WallMotion::Fixed,
         Some(m) if m.is_none() => WallMotion::Fixed,
         Some(m) => {
-            let m = m.cast_into::<PyDict>().map_err(|_| invalid(&format!("{w}.motion"), "not a dict", "a dict or None"))?;
+            let m = m
+                .cast_into::<PyDict>()
+                .map_err(|_| invalid(&format!("{w}.motion"), "not a dict", "a dict or None"))?;
             let mw = format!("{w}.motion");
             let t: String = match m.get_item("type")? {
                 Some(t) => t.extract()?,
-                None => return Err(invalid(&format!("{mw}.type"), "missing", "'constant' or 'harmonic'")),
+                None => {
+                    return Err(invalid(
+                        &format!("{mw}.type"),
+                        "missing",
+                        "'constant' or 'harmonic'",
+                    ))
+                }
             };
             match t.as_str() {
                 "fixed" => WallMotion::Fixed,
-                "constant" => WallMotion::ConstantVelocity { velocity: get_vec3(&m, "velocity", None, &mw)? },
+                "constant" => WallMotion::ConstantVelocity {
+                    velocity: get_vec3(&m, "velocity", None, &mw)?,
+                },
                 "harmonic" => WallMotion::harmonic(
                     get_vec3(&m, "direction", None, &mw)?,
                     get_f64(&m, "amplitude", None, &mw)?,
@@ -123,7 +175,13 @@ fn parse_wall(d: &Bound<'_, PyDict>, k: usize) -> PyResult<Wall> {
                     get_f64(&m, "phase", Some(0.0), &mw)?,
                 )
                 .map_err(PyDemfemError::from)?,
-                other => return Err(invalid(&format!("{mw}.type"), other, "'fixed', 'constant' or 'harmonic'")),
+                other => {
+                    return Err(invalid(
+                        &format!("{mw}.type"),
+                        other,
+                        "'fixed', 'constant' or 'harmonic'",
+                    ))
+                }
             }
         }
     };
@@ -132,7 +190,11 @@ fn parse_wall(d: &Bound<'_, PyDict>, k: usize) -> PyResult<Wall> {
         None => 0,
     };
     if material < 0 {
-        return Err(invalid(&format!("{w}.material"), &material.to_string(), ">= 0"));
+        return Err(invalid(
+            &format!("{w}.material"),
+            &material.to_string(),
+            ">= 0",
+        ));
     }
     Ok(Wall {
         shape,
@@ -199,7 +261,10 @@ impl DemSimulation {
         let n = position.len();
         let radius: Vec<f64> = radii.as_array().to_vec();
         if radius.len() != n {
-            return Err(shape_err("radii", format!("{} entries for {n} particles", radius.len())));
+            return Err(shape_err(
+                "radii",
+                format!("{} entries for {n} particles", radius.len()),
+            ));
         }
         let mut p = ParticleInit::at_rest(position, radius);
         if let Some(v) = velocities {
@@ -211,31 +276,45 @@ impl DemSimulation {
         if let Some(m) = material_ids {
             let m = m.as_array();
             if m.len() != n {
-                return Err(shape_err("material_ids", format!("{} entries for {n} particles", m.len())));
+                return Err(shape_err(
+                    "material_ids",
+                    format!("{} entries for {n} particles", m.len()),
+                ));
             }
             p.material = m
                 .iter()
-                .map(|&x| usize::try_from(x).map_err(|_| invalid("material_ids", &x.to_string(), ">= 0")))
+                .map(|&x| {
+                    usize::try_from(x).map_err(|_| invalid("material_ids", &x.to_string(), ">= 0"))
+                })
                 .collect::<PyResult<_>>()?;
         }
         if let Some(t) = tags {
             let t = t.as_array();
             if t.len() != n {
-                return Err(shape_err("tags", format!("{} entries for {n} particles", t.len())));
+                return Err(shape_err(
+                    "tags",
+                    format!("{} entries for {n} particles", t.len()),
+                ));
             }
             p.tag = t
                 .iter()
-                .map(|&x| u32::try_from(x).map_err(|_| invalid("tags", &x.to_string(), "in [0, 2^32)")))
+                .map(|&x| {
+                    u32::try_from(x).map_err(|_| invalid("tags", &x.to_string(), "in [0, 2^32)"))
+                })
                 .collect::<PyResult<_>>()?;
         }
         let mut mats = Vec::new();
         for (k, m) in materials.iter().enumerate() {
-            let d = m.cast_into::<PyDict>().map_err(|_| invalid(&format!("materials[{k}]"), "not a dict", "a dict"))?;
+            let d = m
+                .cast_into::<PyDict>()
+                .map_err(|_| invalid(&format!("materials[{k}]"), "not a dict", "a dict"))?;
             mats.push(parse_material(&d, k)?);
         }
         let mut ws = Vec::new();
         for (k, w) in walls.iter().enumerate() {
-            let d = w.cast_into::<PyDict>().map_err(|_| invalid(&format!("walls[{k}]"), "not a dict", "a dict"))?;
+            let d = w
+                .cast_into::<PyDict>()
+                .map_err(|_| invalid(&format!("walls[{k}]"), "not a dict", "a dict"))?;
             ws.push(parse_wall(&d, k)?);
         }
         let effects = EffectSet::parse(&effects).map_err(PyDemfemError::from)?;
@@ -244,9 +323,24 @@ impl DemSimulation {
         scene.model = match (model, linear_stiffness) {
             ("hertz_mindlin", _) => ContactModel::HertzMindlin,
             ("hertz_reissner_mindlin", _) => ContactModel::HertzReissnerMindlin,
-            ("linear", Some((kn, kt))) => ContactModel::LinearSpringDashpot { normal_stiffness: kn, tangential_stiffness: kt },
-            ("linear", None) => return Err(invalid("linear_stiffness", "None", "(k_n, k_t) in N/m for model='linear'")),
-            (other, _) => return Err(invalid("model", other, "'hertz_mindlin', 'hertz_reissner_mindlin' or 'linear'")),
+            ("linear", Some((kn, kt))) => ContactModel::LinearSpringDashpot {
+                normal_stiffness: kn,
+                tangential_stiffness: kt,
+            },
+            ("linear", None) => {
+                return Err(invalid(
+                    "linear_stiffness",
+                    "None",
+                    "(k_n, k_t) in N/m for model='linear'",
+                ))
+            }
+            (other, _) => {
+                return Err(invalid(
+                    "model",
+                    other,
+                    "'hertz_mindlin', 'hertz_reissner_mindlin' or 'linear'",
+                ))
+            }
         };
         scene.clamp_normal_force = clamp_normal_force;
         scene.time_step = dt;
@@ -257,7 +351,9 @@ impl DemSimulation {
         scene.initial_overlap_tolerance = overlap_tolerance;
         scene.record_every = record_every;
         scene.record_onsets = record_onsets;
-        let sim = py.detach(|| Simulation::new(&scene)).map_err(PyDemfemError::from)?;
+        let sim = py
+            .detach(|| Simulation::new(&scene))
+            .map_err(PyDemfemError::from)?;
         Ok(DemSimulation { sim })
     }
 
@@ -392,26 +488,40 @@ impl DemSimulation {
         let fr = self.sim.frames();
         let n = self.sim.len();
         let d = PyDict::new(py);
-        d.set_item("time", fr.iter().map(|f| f.time).collect::<Vec<_>>().into_pyarray(py))?;
-        d.set_item("step", fr.iter().map(|f| f.step).collect::<Vec<_>>().into_pyarray(py))?;
-        let stack3 = |get: &dyn Fn(&demfem::dem::Frame) -> &Vec<Vec3>| -> PyResult<Bound<'py, PyAny>> {
-            let mut flat = Vec::with_capacity(fr.len() * n * 3);
-            for f in fr {
-                flat.extend(flat3(get(f)));
-            }
-            Ok(flat.into_pyarray(py).reshape([fr.len(), n, 3])?.into_any())
-        };
+        d.set_item(
+            "time",
+            fr.iter()
+                .map(|f| f.time)
+                .collect::<Vec<_>>()
+                .into_pyarray(py),
+        )?;
+        d.set_item(
+            "step",
+            fr.iter()
+                .map(|f| f.step)
+                .collect::<Vec<_>>()
+                .into_pyarray(py),
+        )?;
+        let stack3 =
+            |get: &dyn Fn(&demfem::dem::Frame) -> &Vec<Vec3>| -> PyResult<Bound<'py, PyAny>> {
+                let mut flat = Vec::with_capacity(fr.len() * n * 3);
+                for f in fr {
+                    flat.extend(flat3(get(f)));
+                }
+                Ok(flat.into_pyarray(py).reshape([fr.len(), n, 3])?.into_any())
+            };
         d.set_item("positions", stack3(&|f| &f.position)?)?;
         d.set_item("velocities", stack3(&|f| &f.velocity)?)?;
         d.set_item("angular_velocities", stack3(&|f| &f.angular_velocity)?)?;
         d.set_item("contact_force_sums", stack3(&|f| &f.contact_force_sum)?)?;
-        let stack_u = |get: &dyn Fn(&demfem::dem::Frame) -> &Vec<u32>| -> PyResult<Bound<'py, PyAny>> {
-            let mut flat = Vec::with_capacity(fr.len() * n);
-            for f in fr {
-                flat.extend_from_slice(get(f));
-            }
-            Ok(flat.into_pyarray(py).reshape([fr.len(), n])?.into_any())
-        };
+        let stack_u =
+            |get: &dyn Fn(&demfem::dem::Frame) -> &Vec<u32>| -> PyResult<Bound<'py, PyAny>> {
+                let mut flat = Vec::with_capacity(fr.len() * n);
+                for f in fr {
+                    flat.extend_from_slice(get(f));
+                }
+                Ok(flat.into_pyarray(py).reshape([fr.len(), n])?.into_any())
+            };
         d.set_item("coordination", stack_u(&|f| &f.coordination)?)?;
         d.set_item("wall_contacts", stack_u(&|f| &f.wall_contacts)?)?;
         Ok(d)
@@ -422,9 +532,27 @@ impl DemSimulation {
     fn onsets<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let o = self.sim.onsets();
         let d = PyDict::new(py);
-        d.set_item("time", o.iter().map(|x| x.time).collect::<Vec<_>>().into_pyarray(py))?;
-        d.set_item("step", o.iter().map(|x| x.step).collect::<Vec<_>>().into_pyarray(py))?;
-        d.set_item("particle", o.iter().map(|x| x.particle).collect::<Vec<_>>().into_pyarray(py))?;
+        d.set_item(
+            "time",
+            o.iter()
+                .map(|x| x.time)
+                .collect::<Vec<_>>()
+                .into_pyarray(py),
+        )?;
+        d.set_item(
+            "step",
+            o.iter()
+                .map(|x| x.step)
+                .collect::<Vec<_>>()
+                .into_pyarray(py),
+        )?;
+        d.set_item(
+            "particle",
+            o.iter()
+                .map(|x| x.particle)
+                .collect::<Vec<_>>()
+                .into_pyarray(py),
+        )?;
         let (partner, is_wall): (Vec<u32>, Vec<bool>) = o
             .iter()
             .map(|x| match x.partner {
@@ -434,10 +562,31 @@ impl DemSimulation {
             .unzip();
         d.set_item("partner", partner.into_pyarray(py))?;
         d.set_item("partner_is_wall", is_wall.into_pyarray(py))?;
-        d.set_item("normal_speed", o.iter().map(|x| x.normal_speed).collect::<Vec<_>>().into_pyarray(py))?;
-        d.set_item("tangential_speed", o.iter().map(|x| x.tangential_speed).collect::<Vec<_>>().into_pyarray(py))?;
-        d.set_item("position", array_n3(py, &o.iter().map(|x| x.position).collect::<Vec<_>>())?)?;
-        d.set_item("partner_position", array_n3(py, &o.iter().map(|x| x.partner_position).collect::<Vec<_>>())?)?;
+        d.set_item(
+            "normal_speed",
+            o.iter()
+                .map(|x| x.normal_speed)
+                .collect::<Vec<_>>()
+                .into_pyarray(py),
+        )?;
+        d.set_item(
+            "tangential_speed",
+            o.iter()
+                .map(|x| x.tangential_speed)
+                .collect::<Vec<_>>()
+                .into_pyarray(py),
+        )?;
+        d.set_item(
+            "position",
+            array_n3(py, &o.iter().map(|x| x.position).collect::<Vec<_>>())?,
+        )?;
+        d.set_item(
+            "partner_position",
+            array_n3(
+                py,
+                &o.iter().map(|x| x.partner_position).collect::<Vec<_>>(),
+            )?,
+        )?;
         Ok(d)
     }
 
@@ -446,7 +595,13 @@ impl DemSimulation {
     fn contacts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let c = self.sim.contacts();
         let d = PyDict::new(py);
-        d.set_item("particle", c.iter().map(|x| x.particle).collect::<Vec<_>>().into_pyarray(py))?;
+        d.set_item(
+            "particle",
+            c.iter()
+                .map(|x| x.particle)
+                .collect::<Vec<_>>()
+                .into_pyarray(py),
+        )?;
         let (partner, is_wall): (Vec<u32>, Vec<bool>) = c
             .iter()
             .map(|x| match x.partner {
@@ -456,11 +611,35 @@ impl DemSimulation {
             .unzip();
         d.set_item("partner", partner.into_pyarray(py))?;
         d.set_item("partner_is_wall", is_wall.into_pyarray(py))?;
-        d.set_item("normal", array_n3(py, &c.iter().map(|x| x.normal).collect::<Vec<_>>())?)?;
-        d.set_item("normal_force", c.iter().map(|x| x.normal_force).collect::<Vec<_>>().into_pyarray(py))?;
-        d.set_item("tangential_force", array_n3(py, &c.iter().map(|x| x.tangential_force).collect::<Vec<_>>())?)?;
-        d.set_item("overlap", c.iter().map(|x| x.overlap).collect::<Vec<_>>().into_pyarray(py))?;
-        d.set_item("point", array_n3(py, &c.iter().map(|x| x.point).collect::<Vec<_>>())?)?;
+        d.set_item(
+            "normal",
+            array_n3(py, &c.iter().map(|x| x.normal).collect::<Vec<_>>())?,
+        )?;
+        d.set_item(
+            "normal_force",
+            c.iter()
+                .map(|x| x.normal_force)
+                .collect::<Vec<_>>()
+                .into_pyarray(py),
+        )?;
+        d.set_item(
+            "tangential_force",
+            array_n3(
+                py,
+                &c.iter().map(|x| x.tangential_force).collect::<Vec<_>>(),
+            )?,
+        )?;
+        d.set_item(
+            "overlap",
+            c.iter()
+                .map(|x| x.overlap)
+                .collect::<Vec<_>>()
+                .into_pyarray(py),
+        )?;
+        d.set_item(
+            "point",
+            array_n3(py, &c.iter().map(|x| x.point).collect::<Vec<_>>())?,
+        )?;
         Ok(d)
     }
 
@@ -497,7 +676,11 @@ impl DemSimulation {
     fn interrupt_check(&self, py: Python<'_>) -> PyResult<()> {
         if let Err(e) = py.check_signals() {
             if e.is_instance_of::<pyo3::exceptions::PyKeyboardInterrupt>(py) {
-                return Err(PyDemfemError::from(DemfemError::Interrupted { time: self.sim.time(), steps: self.sim.steps() }).into());
+                return Err(PyDemfemError::from(DemfemError::Interrupted {
+                    time: self.sim.time(),
+                    steps: self.sim.steps(),
+                })
+                .into());
             }
             return Err(e);
         }

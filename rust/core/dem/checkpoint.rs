@@ -49,7 +49,10 @@ struct Reader<'a> {
 impl Reader<'_> {
     fn take(&mut self, n: usize) -> Result<&[u8]> {
         if self.at + n > self.data.len() {
-            return Err(DemfemError::Io { path: self.path.into(), detail: "truncated checkpoint".into() });
+            return Err(DemfemError::Io {
+                path: self.path.into(),
+                detail: "truncated checkpoint".into(),
+            });
         }
         let s = &self.data[self.at..self.at + n];
         self.at += n;
@@ -124,7 +127,9 @@ impl Simulation {
 
     /// The checkpoint as bytes.
     pub fn checkpoint_bytes(&self) -> Vec<u8> {
-        let mut w = Writer(Vec::with_capacity(64 + self.position.len() * 100 + self.pairs.len() * 40));
+        let mut w = Writer(Vec::with_capacity(
+            64 + self.position.len() * 100 + self.pairs.len() * 40,
+        ));
         w.0.extend_from_slice(MAGIC);
         w.u32(CHECKPOINT_VERSION);
         w.u64(self.scene_fingerprint());
@@ -163,7 +168,10 @@ impl Simulation {
 
     /// Write a checkpoint atomically (temp file, fsync, rename).
     pub fn save_checkpoint(&self, path: &Path) -> Result<()> {
-        let io = |e: std::io::Error| DemfemError::Io { path: path.display().to_string(), detail: e.to_string() };
+        let io = |e: std::io::Error| DemfemError::Io {
+            path: path.display().to_string(),
+            detail: e.to_string(),
+        };
         let mut tmp = path.as_os_str().to_owned();
         tmp.push(".tmp");
         let tmp = std::path::PathBuf::from(tmp);
@@ -175,7 +183,11 @@ impl Simulation {
         std::fs::rename(&tmp, path).map_err(io)?;
         if let Some(dir) = path.parent() {
             // make the rename itself durable; not every platform can open a directory
-            if let Ok(d) = std::fs::File::open(if dir.as_os_str().is_empty() { Path::new(".") } else { dir }) {
+            if let Ok(d) = std::fs::File::open(if dir.as_os_str().is_empty() {
+                Path::new(".")
+            } else {
+                dir
+            }) {
                 let _ = d.sync_all();
             }
         }
@@ -185,17 +197,24 @@ impl Simulation {
     /// Restore the state from checkpoint bytes; `path` only names the source in errors.
     pub fn restore_checkpoint_bytes(&mut self, data: &[u8], path: &str) -> Result<()> {
         let mut r = Reader { data, at: 0, path };
-        let bad = |detail: String| DemfemError::Io { path: path.into(), detail };
+        let bad = |detail: String| DemfemError::Io {
+            path: path.into(),
+            detail,
+        };
         if r.take(8)? != MAGIC {
             return Err(bad("not a demfem checkpoint (bad magic)".into()));
         }
         let version = r.u32()?;
         if version != CHECKPOINT_VERSION {
-            return Err(bad(format!("checkpoint version {version}, this build reads {CHECKPOINT_VERSION}")));
+            return Err(bad(format!(
+                "checkpoint version {version}, this build reads {CHECKPOINT_VERSION}"
+            )));
         }
         let fp = r.u64()?;
         if fp != self.scene_fingerprint() {
-            return Err(bad("checkpoint was written by a different scene (fingerprint mismatch)".into()));
+            return Err(bad(
+                "checkpoint was written by a different scene (fingerprint mismatch)".into(),
+            ));
         }
         let n = self.position.len();
         if r.u64()? != n as u64 || r.u64()? != self.walls.len() as u64 {
@@ -231,7 +250,13 @@ impl Simulation {
             }
             let active = r.u8()? != 0;
             let history = r.vec3()?;
-            pairs.push(PairContact { i, j, active, history, ..Default::default() });
+            pairs.push(PairContact {
+                i,
+                j,
+                active,
+                history,
+                ..Default::default()
+            });
         }
         let stride = r.count(self.walls.len().max(1), "wall stride")?.max(1);
         let n_slots = r.count(n * stride, "wall slot")?;
@@ -246,7 +271,12 @@ impl Simulation {
             }
             let active = r.u8()? != 0;
             let history = r.vec3()?;
-            slots.push(WallContact { wall, active, history, ..Default::default() });
+            slots.push(WallContact {
+                wall,
+                active,
+                history,
+                ..Default::default()
+            });
         }
         if r.at != data.len() {
             return Err(bad("trailing bytes after checkpoint".into()));
@@ -272,8 +302,10 @@ impl Simulation {
     /// Load a checkpoint written by [`Simulation::save_checkpoint`] from a simulation built
     /// from the same scene.
     pub fn load_checkpoint(&mut self, path: &Path) -> Result<()> {
-        let data = std::fs::read(path)
-            .map_err(|e| DemfemError::Io { path: path.display().to_string(), detail: e.to_string() })?;
+        let data = std::fs::read(path).map_err(|e| DemfemError::Io {
+            path: path.display().to_string(),
+            detail: e.to_string(),
+        })?;
         self.restore_checkpoint_bytes(&data, &path.display().to_string())
     }
 }

@@ -66,10 +66,17 @@ impl Effect {
 
     /// Parse a scene-file name; unknown names are an [`DemfemError::Effect`].
     pub fn parse(name: &str) -> Result<Effect> {
-        Effect::ALL.iter().copied().find(|e| e.name() == name).ok_or_else(|| {
-            let known: Vec<&str> = Effect::ALL.iter().map(|e| e.name()).collect();
-            DemfemError::Effect(format!("unknown effect '{name}'; known: {}", known.join(", ")))
-        })
+        Effect::ALL
+            .iter()
+            .copied()
+            .find(|e| e.name() == name)
+            .ok_or_else(|| {
+                let known: Vec<&str> = Effect::ALL.iter().map(|e| e.name()).collect();
+                DemfemError::Effect(format!(
+                    "unknown effect '{name}'; known: {}",
+                    known.join(", ")
+                ))
+            })
     }
 }
 
@@ -115,7 +122,11 @@ impl EffectSet {
 
     /// Names of the effects in the set, in [`Effect::ALL`] order.
     pub fn names(self) -> Vec<&'static str> {
-        Effect::ALL.iter().filter(|e| self.has(**e)).map(|e| e.name()).collect()
+        Effect::ALL
+            .iter()
+            .filter(|e| self.has(**e))
+            .map(|e| e.name())
+            .collect()
     }
 
     /// Raw bits (for checkpoints).

@@ -57,10 +57,18 @@ impl Material {
         check_non_negative(&f("friction"), self.friction)?;
         check_non_negative(&f("rolling_friction"), self.rolling_friction)?;
         if !(self.restitution.is_finite() && self.restitution > 0.0 && self.restitution <= 1.0) {
-            return Err(DemfemError::invalid(&f("restitution"), self.restitution, "in (0, 1]"));
+            return Err(DemfemError::invalid(
+                &f("restitution"),
+                self.restitution,
+                "in (0, 1]",
+            ));
         }
         if !(self.shell_stiffness > 0.0) || self.shell_stiffness.is_nan() {
-            return Err(DemfemError::invalid(&f("shell_stiffness"), self.shell_stiffness, "> 0 (inf: no shell)"));
+            return Err(DemfemError::invalid(
+                &f("shell_stiffness"),
+                self.shell_stiffness,
+                "> 0 (inf: no shell)",
+            ));
         }
         Ok(())
     }
@@ -94,7 +102,11 @@ pub enum ContactModel {
 impl ContactModel {
     /// Validate the model's own parameters.
     pub fn validate(&self) -> Result<()> {
-        if let ContactModel::LinearSpringDashpot { normal_stiffness, tangential_stiffness } = *self {
+        if let ContactModel::LinearSpringDashpot {
+            normal_stiffness,
+            tangential_stiffness,
+        } = *self
+        {
             check_positive("normal_stiffness", normal_stiffness)?;
             check_positive("tangential_stiffness", tangential_stiffness)?;
         }
@@ -136,16 +148,26 @@ impl PairLaw {
     /// Derive the pair parameters of materials `a` and `b` under `model`.
     pub fn new(a: &Material, b: &Material, model: ContactModel, clamp: ForceClamp) -> Result<Self> {
         let restitution = a.restitution.min(b.restitution);
-        let zeta = if model.is_hertzian() { contact::tsuji_damping_for_restitution(restitution, clamp)? } else { 0.0 };
+        let zeta = if model.is_hertzian() {
+            contact::tsuji_damping_for_restitution(restitution, clamp)?
+        } else {
+            0.0
+        };
         Self::with_zeta(a, b, model, zeta)
     }
 
     /// As [`PairLaw::new`] with the Tsuji parameter ζ already known (it costs a bisection
     /// over an ODE solve, so a scene computes it once per distinct restitution).
     pub fn with_zeta(a: &Material, b: &Material, model: ContactModel, zeta: f64) -> Result<Self> {
-        let e_star = contact::effective_modulus(a.young_modulus, a.poisson_ratio, b.young_modulus, b.poisson_ratio)?;
+        let e_star = contact::effective_modulus(
+            a.young_modulus,
+            a.poisson_ratio,
+            b.young_modulus,
+            b.poisson_ratio,
+        )?;
         let g_star = 1.0
-            / ((2.0 - a.poisson_ratio) / a.shear_modulus() + (2.0 - b.poisson_ratio) / b.shear_modulus());
+            / ((2.0 - a.poisson_ratio) / a.shear_modulus()
+                + (2.0 - b.poisson_ratio) / b.shear_modulus());
         let shell_stiffness = if a.shell_stiffness.is_infinite() {
             b.shell_stiffness
         } else if b.shell_stiffness.is_infinite() {
@@ -158,11 +180,18 @@ impl PairLaw {
             ContactModel::HertzMindlin | ContactModel::HertzReissnerMindlin => {
                 (zeta, 0.0, (4.0 * g_star / e_star).sqrt())
             }
-            ContactModel::LinearSpringDashpot { normal_stiffness, tangential_stiffness } => {
+            ContactModel::LinearSpringDashpot {
+                normal_stiffness,
+                tangential_stiffness,
+            } => {
                 // damped oscillator: e = exp(-β π / √(1-β²)) ⇔ β = -ln e / √(π² + ln² e)
                 let ln_e = restitution.ln();
                 let beta = -ln_e / (std::f64::consts::PI.powi(2) + ln_e * ln_e).sqrt();
-                (0.0, 2.0 * beta, (tangential_stiffness / normal_stiffness).sqrt())
+                (
+                    0.0,
+                    2.0 * beta,
+                    (tangential_stiffness / normal_stiffness).sqrt(),
+                )
             }
         };
         Ok(PairLaw {

@@ -89,7 +89,12 @@ impl Scene {
     /// A scene with the default numerical settings: Hertz–Mindlin, clamped normal force, step
     /// 0.2 × the stable limit at an expected 1 m/s, skin 0.1 d, 1 thread, 1 % overlap
     /// tolerance, no records.
-    pub fn new(particles: ParticleInit, materials: Vec<Material>, walls: Vec<Wall>, effects: EffectSet) -> Self {
+    pub fn new(
+        particles: ParticleInit,
+        materials: Vec<Material>,
+        walls: Vec<Wall>,
+        effects: EffectSet,
+    ) -> Self {
         Scene {
             particles,
             materials,
@@ -131,7 +136,10 @@ impl Scene {
             return Err(DemfemError::invalid("particle count", n as f64, "< 2^31"));
         }
         if self.materials.is_empty() {
-            return Err(DemfemError::ShapeMismatch { field: "materials".into(), detail: "empty".into() });
+            return Err(DemfemError::ShapeMismatch {
+                field: "materials".into(),
+                detail: "empty".into(),
+            });
         }
         for (k, m) in self.materials.iter().enumerate() {
             m.validate(k)?;
@@ -200,19 +208,28 @@ impl Scene {
             if e.has(effect) {
                 Ok(())
             } else {
-                Err(DemfemError::Effect(format!("{why} but the scene does not name '{}'", effect.name())))
+                Err(DemfemError::Effect(format!(
+                    "{why} but the scene does not name '{}'",
+                    effect.name()
+                )))
             }
         };
         let unused = |effect: Effect, why: &str| -> Result<()> {
             if e.has(effect) {
-                Err(DemfemError::Effect(format!("the scene names '{}' but {why}", effect.name())))
+                Err(DemfemError::Effect(format!(
+                    "the scene names '{}' but {why}",
+                    effect.name()
+                )))
             } else {
                 Ok(())
             }
         };
         // gravity
         if self.gravity != Vec3::ZERO {
-            need(Effect::Gravity, format!("gravity = {:?} m/s² is non-zero", self.gravity))?;
+            need(
+                Effect::Gravity,
+                format!("gravity = {:?} m/s² is non-zero", self.gravity),
+            )?;
         } else {
             unused(Effect::Gravity, "gravity is zero")?;
         }
@@ -226,7 +243,10 @@ impl Scene {
             }
             if wall.motion.is_moving() {
                 any_moving = true;
-                need(Effect::MovingWalls, format!("walls[{w}] has a prescribed motion"))?;
+                need(
+                    Effect::MovingWalls,
+                    format!("walls[{w}] has a prescribed motion"),
+                )?;
             }
         }
         if !any_surface {
@@ -256,38 +276,65 @@ impl Scene {
             }
             if m.friction > 0.0 {
                 any_friction = true;
-                need(Effect::Friction, format!("materials[{k}].friction = {} > 0", m.friction))?;
+                need(
+                    Effect::Friction,
+                    format!("materials[{k}].friction = {} > 0", m.friction),
+                )?;
             }
             if m.rolling_friction > 0.0 {
                 any_rolling = true;
-                need(Effect::RollingResistance, format!("materials[{k}].rolling_friction = {} > 0", m.rolling_friction))?;
+                need(
+                    Effect::RollingResistance,
+                    format!(
+                        "materials[{k}].rolling_friction = {} > 0",
+                        m.rolling_friction
+                    ),
+                )?;
             }
             if m.restitution < 1.0 {
                 any_damping = true;
-                need(Effect::Damping, format!("materials[{k}].restitution = {} < 1", m.restitution))?;
+                need(
+                    Effect::Damping,
+                    format!("materials[{k}].restitution = {} < 1", m.restitution),
+                )?;
             }
         }
         if !any_friction {
             unused(Effect::Friction, "every material in use is frictionless")?;
         }
         if !any_rolling {
-            unused(Effect::RollingResistance, "no material in use has rolling friction")?;
+            unused(
+                Effect::RollingResistance,
+                "no material in use has rolling friction",
+            )?;
         }
         if !any_damping {
             unused(Effect::Damping, "every material in use has restitution 1")?;
         }
         if e.has(Effect::RollingResistance) && !e.has(Effect::Rotation) {
-            return Err(DemfemError::Effect("'rolling_resistance' acts on rotation: name 'rotation' too".into()));
+            return Err(DemfemError::Effect(
+                "'rolling_resistance' acts on rotation: name 'rotation' too".into(),
+            ));
         }
         if !e.has(Effect::Rotation) {
-            if let Some(i) = self.particles.angular_velocity.iter().position(|w| *w != Vec3::ZERO) {
+            if let Some(i) = self
+                .particles
+                .angular_velocity
+                .iter()
+                .position(|w| *w != Vec3::ZERO)
+            {
                 return Err(DemfemError::Effect(format!(
                     "particles.angular_velocity[{i}] is non-zero but the scene does not name 'rotation'"
                 )));
             }
         }
         if e.has(Effect::Planar) {
-            if let Some(i) = self.particles.angular_velocity.iter().position(|w| w.x != 0.0 || w.y != 0.0) {
+            if let Some(i) = self
+                .particles
+                .angular_velocity
+                .iter()
+                .position(|w| w.x != 0.0 || w.y != 0.0)
+            {
                 return Err(DemfemError::Effect(format!(
                     "'planar' allows rotation about z only, but particles.angular_velocity[{i}] has x or y components"
                 )));

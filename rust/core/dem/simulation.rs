@@ -60,6 +60,18 @@ pub(crate) struct PairContact {
     pub(crate) onset: bool,
 }
 
+/// What the gather needs of a pair, written by the pair phase every step: one 64-byte line
+/// per pair, so the gather (which visits pairs in particle order, not memory order) touches
+/// one cache line per contact.
+#[derive(Debug, Clone, Copy, Default)]
+#[repr(C, align(64))]
+pub(crate) struct PairOut {
+    force: Vec3,
+    torque_per_arm: Vec3,
+    /// > 0 exactly when the pair is in contact.
+    overlap: f64,
+}
+
 /// A candidate particle–wall contact slot.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct WallContact {
@@ -141,6 +153,7 @@ pub struct Simulation {
     pub(crate) time: f64,
     pub(crate) steps: u64,
     pub(crate) pairs: Vec<PairContact>,
+    pair_out: Vec<PairOut>,
     pub(crate) wall_slots: Vec<WallContact>,
     pub(crate) wall_stride: usize,
     pub(crate) reference_position: Vec<Vec3>,
@@ -199,6 +212,7 @@ struct PairCtx<'a> {
 /// Read-only context of the particle phase.
 struct ParticleCtx<'a> {
     pairs: &'a [PairContact],
+    pair_out: &'a [PairOut],
     csr_offset: &'a [u32],
     csr_entry: &'a [u32],
     radius: &'a [f64],
@@ -235,24 +249,40 @@ fn contact_law(
     let (f_el, k_n, k_t) = match model {
         ContactModel::HertzMindlin => {
             let a = (r_star * overlap).sqrt(); // contact radius
-            (4.0 / 3.0 * law.e_star * a * overlap, 2.0 * law.e_star * a, 8.0 * law.g_star * a)
+            (
+                4.0 / 3.0 * law.e_star * a * overlap,
+                2.0 * law.e_star * a,
+                8.0 * law.g_star * a,
+            )
         }
         ContactModel::HertzReissnerMindlin => {
             let k_h = 4.0 / 3.0 * law.e_star * r_star.sqrt();
             if law.shell_stiffness.is_infinite() {
                 let a = (r_star * overlap).sqrt();
-                (4.0 / 3.0 * law.e_star * a * overlap, 2.0 * law.e_star * a, 8.0 * law.g_star * a)
+                (
+                    4.0 / 3.0 * law.e_star * a * overlap,
+                    2.0 * law.e_star * a,
+                    8.0 * law.g_star * a,
+                )
             } else {
-                let (f, k) = contact::NormalLaw::HertzReissner { k_h, k_r: law.shell_stiffness }
-                    .force_and_stiffness(overlap);
+                let (f, k) = contact::NormalLaw::HertzReissner {
+                    k_h,
+                    k_r: law.shell_stiffness,
+                }
+                .force_and_stiffness(overlap);
                 // Mindlin spring on the Hertz indentation δ_H = (F/k_H)^{2/3} only
                 let delta_h = (f / k_h).powf(2.0 / 3.0);
                 (f, k, 8.0 * law.g_star * (r_star * delta_h).sqrt())
             }
         }
-        ContactModel::LinearSpringDashpot { normal_stiffness, tangential_stiffness } => {
-            (normal_stiffness * overlap, normal_stiffness, tangential_stiffness)
-        }
+        ContactModel::LinearSpringDashpot {
+            normal_stiffness,
+            tangential_stiffness,
+        } => (
+            normal_stiffness * overlap,
+            normal_stiffness,
+            tangential_stiffness,
+        ),
     };
     let c_n = if effects.has(Effect::Damping) {
         match model {
@@ -288,7 +318,11 @@ fn tangential_force(
     if f2 > cap * cap {
         // gross sliding: the force sits on the cone; the spring carries it all
         f_t *= cap / f2.sqrt();
-        xi = if k_t > 0.0 { -f_t / k_t } else { Vec3::ZERO };
+        xi = if k_t > 0.0 {
+            f_t * (-1.0 / k_t)
+        } else {
+            Vec3::ZERO
+        };
     }
     *history = xi;
     f_t
@@ -296,7 +330,7 @@ fn tangential_force(
 
 /// Force of one candidate pair; returns whether a contact began.
 #[inline(always)]
-fn pair_kernel(p: &mut PairContact, c: &PairCtx<'_>) -> bool {
+fn pair_kernel(p: &mut PairContact, out: &mut PairOut, c: &PairCtx<'_>) -> bool {
     let i = p.i as usize;
     let j = p.j as usize;
     let d = c.position[j] - c.position[i];
@@ -312,6 +346,7 @@ fn pair_kernel(p: &mut PairContact, c: &PairCtx<'_>) -> bool {
             p.overlap = 0.0;
             p.normal_force = 0.0;
         }
+        out.overlap = 0.0;
         p.onset = false;
         return false;
     }
@@ -319,7 +354,7 @@ fn pair_kernel(p: &mut PairContact, c: &PairCtx<'_>) -> bool {
     // rounding can give dist = r_sum for dist² just below r_sum²; keep the overlap positive,
     // the gather's activity test
     let overlap = (r_sum - dist).max(f64::MIN_POSITIVE);
-    let n = d / dist;
+    let n = d * (1.0 / dist); // one division instead of three
     let rotation = c.effects.has(Effect::Rotation);
     let arm_i = c.radius[i] - 0.5 * overlap;
     let arm_j = c.radius[j] - 0.5 * overlap;
@@ -375,6 +410,11 @@ fn pair_kernel(p: &mut PairContact, c: &PairCtx<'_>) -> bool {
     p.normal = n;
     p.overlap = overlap;
     p.normal_force = f_n;
+    *out = PairOut {
+        force,
+        torque_per_arm: p.torque_per_arm,
+        overlap,
+    };
     onset
 }
 
@@ -485,7 +525,11 @@ fn particle_chunk(
     let rotation = c.effects.has(Effect::Rotation);
     let rolling = c.effects.has(Effect::RollingResistance);
     let planar = c.effects.has(Effect::Planar);
-    let gravity = if c.effects.has(Effect::Gravity) { c.gravity } else { Vec3::ZERO };
+    let gravity = if c.effects.has(Effect::Gravity) {
+        c.gravity
+    } else {
+        Vec3::ZERO
+    };
     let mut max_disp2: f64 = 0.0;
     let mut bad = false;
     let mut wall_onsets = 0u32;
@@ -499,7 +543,7 @@ fn particle_chunk(
         let mut z = 0u32;
         let (a, b) = (c.csr_offset[i] as usize, c.csr_offset[i + 1] as usize);
         for &e in &c.csr_entry[a..b] {
-            let p = &c.pairs[(e >> 1) as usize];
+            let p = &c.pair_out[(e >> 1) as usize];
             if !(p.overlap > 0.0) {
                 continue;
             }
@@ -513,7 +557,8 @@ fn particle_chunk(
             if rotation {
                 t += arm * p.torque_per_arm;
                 if rolling {
-                    t += if e & 1 == 0 { p.rolling_torque } else { -p.rolling_torque };
+                    let m = c.pairs[(e >> 1) as usize].rolling_torque;
+                    t += if e & 1 == 0 { m } else { -m };
                 }
             }
         }
@@ -571,12 +616,20 @@ impl Simulation {
         let mut inertia = Vec::with_capacity(n);
         for i in 0..n {
             let r = p.radius[i];
-            let m = scene.materials[p.material[i]].density * 4.0 / 3.0 * std::f64::consts::PI * r * r * r;
+            let m = scene.materials[p.material[i]].density * 4.0 / 3.0
+                * std::f64::consts::PI
+                * r
+                * r
+                * r;
             mass.push(m);
             inertia.push(0.4 * m * r * r);
         }
         let n_materials = scene.materials.len();
-        let clamp = if scene.clamp_normal_force { ForceClamp::NonNegative } else { ForceClamp::None };
+        let clamp = if scene.clamp_normal_force {
+            ForceClamp::NonNegative
+        } else {
+            ForceClamp::None
+        };
         let mut laws = Vec::with_capacity(n_materials * n_materials);
         // ζ from restitution costs a bisection over an ODE solve: once per distinct e
         let mut zeta_cache: Vec<(u64, f64)> = Vec::new();
@@ -600,7 +653,11 @@ impl Simulation {
         let dt = match scene.time_step {
             Some(dt) => {
                 if dt > stable.limit {
-                    return Err(DemfemError::UnstableTimeStep { dt, limit: stable.limit, reason: stable.reason.clone() });
+                    return Err(DemfemError::UnstableTimeStep {
+                        dt,
+                        limit: stable.limit,
+                        reason: stable.reason.clone(),
+                    });
                 }
                 dt
             }
@@ -613,7 +670,12 @@ impl Simulation {
                 rayon::ThreadPoolBuilder::new()
                     .num_threads(scene.threads)
                     .build()
-                    .map_err(|e| DemfemError::Numerical(format!("cannot start {} threads: {e}", scene.threads)))?,
+                    .map_err(|e| {
+                        DemfemError::Numerical(format!(
+                            "cannot start {} threads: {e}",
+                            scene.threads
+                        ))
+                    })?,
             )
         } else {
             None
@@ -646,6 +708,7 @@ impl Simulation {
             time: 0.0,
             steps: 0,
             pairs: Vec::new(),
+            pair_out: Vec::new(),
             wall_slots: Vec::new(),
             wall_stride: 1,
             reference_position: p.position.clone(),
@@ -677,7 +740,8 @@ impl Simulation {
     fn check_initial_overlaps(&self, tolerance: f64) -> Result<()> {
         for p in &self.pairs {
             let (i, j) = (p.i as usize, p.j as usize);
-            let overlap = self.radius[i] + self.radius[j] - (self.position[j] - self.position[i]).length();
+            let overlap =
+                self.radius[i] + self.radius[j] - (self.position[j] - self.position[i]).length();
             if overlap > tolerance * self.radius[i].min(self.radius[j]) {
                 return Err(DemfemError::InvalidParameter {
                     field: format!("particles {i} and {j}"),
@@ -692,7 +756,9 @@ impl Simulation {
                     break;
                 }
                 let ws = self.wall_state[s.wall as usize];
-                if let Some((_, _, d)) = self.walls[s.wall as usize].closest_at(self.position[i], ws.offset) {
+                if let Some((_, _, d)) =
+                    self.walls[s.wall as usize].closest_at(self.position[i], ws.offset)
+                {
                     let overlap = self.radius[i] - d;
                     if overlap > tolerance * self.radius[i] {
                         return Err(DemfemError::InvalidParameter {
@@ -710,7 +776,11 @@ impl Simulation {
     pub(crate) fn refresh_wall_state(&mut self) {
         let moving = self.effects.has(Effect::MovingWalls);
         for (k, w) in self.walls.iter().enumerate() {
-            let (offset, velocity) = if moving { w.motion.offset_and_velocity(self.time) } else { (Vec3::ZERO, Vec3::ZERO) };
+            let (offset, velocity) = if moving {
+                w.motion.offset_and_velocity(self.time)
+            } else {
+                (Vec3::ZERO, Vec3::ZERO)
+            };
             self.wall_state[k] = WallState { offset, velocity };
         }
     }
@@ -719,6 +789,8 @@ impl Simulation {
     /// with the side (bit 0: particle is j). A pure function of the pair list.
     pub(crate) fn build_gather_lists(&mut self) {
         let n = self.position.len();
+        self.pair_out.clear();
+        self.pair_out.resize(self.pairs.len(), PairOut::default());
         self.csr_offset.clear();
         self.csr_offset.resize(n + 1, 0);
         for p in &self.pairs {
@@ -745,19 +817,33 @@ impl Simulation {
         let n = self.position.len();
         self.rebuilds += 1;
         // ---- particle pairs
-        self.grid.candidate_pairs(&self.position, &self.radius, &self.alive, self.skin, &mut self.candidate_scratch);
+        self.grid.candidate_pairs(
+            &self.position,
+            &self.radius,
+            &self.alive,
+            self.skin,
+            &mut self.candidate_scratch,
+        );
         std::mem::swap(&mut self.pairs, &mut self.old_pairs);
         self.pairs.clear();
         let mut old = 0usize;
         for &(i, j) in &self.candidate_scratch {
             // both lists are sorted by (i, j): merge to carry the state of surviving pairs
-            while old < self.old_pairs.len() && (self.old_pairs[old].i, self.old_pairs[old].j) < (i, j) {
+            while old < self.old_pairs.len()
+                && (self.old_pairs[old].i, self.old_pairs[old].j) < (i, j)
+            {
                 old += 1;
             }
-            if old < self.old_pairs.len() && (self.old_pairs[old].i, self.old_pairs[old].j) == (i, j) {
+            if old < self.old_pairs.len()
+                && (self.old_pairs[old].i, self.old_pairs[old].j) == (i, j)
+            {
                 self.pairs.push(self.old_pairs[old]);
             } else {
-                self.pairs.push(PairContact { i, j, ..Default::default() });
+                self.pairs.push(PairContact {
+                    i,
+                    j,
+                    ..Default::default()
+                });
             }
         }
         self.build_gather_lists();
@@ -772,7 +858,9 @@ impl Simulation {
             }
             let reach = self.radius[i] + self.skin;
             for (w, wall) in self.walls.iter().enumerate() {
-                if let Some((_, _, d)) = wall.closest_at(self.position[i], self.wall_state[w].offset) {
+                if let Some((_, _, d)) =
+                    wall.closest_at(self.position[i], self.wall_state[w].offset)
+                {
                     if d < reach {
                         counts[i] += 1;
                     }
@@ -790,14 +878,18 @@ impl Simulation {
             let reach = self.radius[i] + self.skin;
             let mut k = 0;
             for (w, wall) in self.walls.iter().enumerate() {
-                if let Some((_, _, d)) = wall.closest_at(self.position[i], self.wall_state[w].offset) {
+                if let Some((_, _, d)) =
+                    wall.closest_at(self.position[i], self.wall_state[w].offset)
+                {
                     if d < reach {
                         let carried = self
                             .old_slots
                             .get(i * old_stride..(i + 1) * old_stride)
                             .and_then(|s| s.iter().find(|s| s.wall == w as u32).copied());
-                        self.wall_slots[i * stride + k] =
-                            carried.unwrap_or(WallContact { wall: w as u32, ..Default::default() });
+                        self.wall_slots[i * stride + k] = carried.unwrap_or(WallContact {
+                            wall: w as u32,
+                            ..Default::default()
+                        });
                         k += 1;
                     }
                 }
@@ -868,19 +960,27 @@ impl Simulation {
                 clamp: self.clamp,
                 dt: self.dt,
             };
-            let kernel = |chunk: &mut [PairContact]| -> u32 {
+            let kernel = |(chunk, out): (&mut [PairContact], &mut [PairOut])| -> u32 {
                 let mut onsets = 0u32;
-                for p in chunk {
-                    onsets += pair_kernel(p, &ctx) as u32;
+                for (p, o) in chunk.iter_mut().zip(out.iter_mut()) {
+                    onsets += pair_kernel(p, o, &ctx) as u32;
                 }
                 onsets
             };
             if parallel {
-                self.pairs.par_chunks_mut(PAIR_CHUNK).map(kernel).collect_into_vec(&mut self.chunk_onsets);
+                self.pairs
+                    .par_chunks_mut(PAIR_CHUNK)
+                    .zip(self.pair_out.par_chunks_mut(PAIR_CHUNK))
+                    .map(kernel)
+                    .collect_into_vec(&mut self.chunk_onsets);
             } else {
                 self.chunk_onsets.clear();
                 let onsets = &mut self.chunk_onsets;
-                for chunk in self.pairs.chunks_mut(PAIR_CHUNK) {
+                for chunk in self
+                    .pairs
+                    .chunks_mut(PAIR_CHUNK)
+                    .zip(self.pair_out.chunks_mut(PAIR_CHUNK))
+                {
                     onsets.push(kernel(chunk));
                 }
             }
@@ -890,6 +990,7 @@ impl Simulation {
         {
             let ctx = ParticleCtx {
                 pairs: &self.pairs,
+                pair_out: &self.pair_out,
                 csr_offset: &self.csr_offset,
                 csr_entry: &self.csr_entry,
                 radius: &self.radius,
@@ -938,7 +1039,17 @@ impl Simulation {
                     .zip(self.wall_slots.chunks_mut(PARTICLE_CHUNK * stride))
                     .enumerate();
                 for (c, ((((((x, v), w), f), z), zw), s)) in iter {
-                    self.chunk_results.push(particle_chunk(&ctx, c * PARTICLE_CHUNK, x, v, w, f, z, zw, s));
+                    self.chunk_results.push(particle_chunk(
+                        &ctx,
+                        c * PARTICLE_CHUNK,
+                        x,
+                        v,
+                        w,
+                        f,
+                        z,
+                        zw,
+                        s,
+                    ));
                 }
             }
         }
@@ -1184,7 +1295,11 @@ impl Simulation {
     /// Remove particle `i` from the simulation (it stops interacting and moving).
     pub fn remove_particle(&mut self, i: usize) -> Result<()> {
         if i >= self.position.len() {
-            return Err(DemfemError::invalid("particle index", i as f64, &format!("< {}", self.position.len())));
+            return Err(DemfemError::invalid(
+                "particle index",
+                i as f64,
+                &format!("< {}", self.position.len()),
+            ));
         }
         self.alive[i] = false;
         self.needs_rebuild = true;
@@ -1205,8 +1320,18 @@ impl Simulation {
 
     /// Largest particle–particle or particle–wall overlap at the last step, m.
     pub fn max_overlap(&self) -> f64 {
-        let a = self.pairs.iter().filter(|p| p.active).map(|p| p.overlap).fold(0.0, f64::max);
-        let b = self.wall_slots.iter().filter(|s| s.wall != NO_WALL && s.active).map(|s| s.overlap).fold(0.0, f64::max);
+        let a = self
+            .pairs
+            .iter()
+            .filter(|p| p.active)
+            .map(|p| p.overlap)
+            .fold(0.0, f64::max);
+        let b = self
+            .wall_slots
+            .iter()
+            .filter(|s| s.wall != NO_WALL && s.active)
+            .map(|s| s.overlap)
+            .fold(0.0, f64::max);
         a.max(b)
     }
 
@@ -1230,10 +1355,16 @@ pub fn stable_time_step(scene: &Scene, mass: &[f64]) -> Result<StableStep> {
     let v = scene.expected_max_speed;
     let friction = scene.effects.has(Effect::Friction);
     let rotation = scene.effects.has(Effect::Rotation);
-    let mut best = StableStep { limit: f64::INFINITY, reason: "no particle".into() };
+    let mut best = StableStep {
+        limit: f64::INFINITY,
+        reason: "no particle".into(),
+    };
     let mut consider = |limit: f64, reason: &dyn Fn() -> String| {
         if limit < best.limit {
-            best = StableStep { limit, reason: reason() };
+            best = StableStep {
+                limit,
+                reason: reason(),
+            };
         }
     };
     // distinct (material, radius, mass) classes only: the table is usually monodisperse
@@ -1251,19 +1382,36 @@ pub fn stable_time_step(scene: &Scene, mass: &[f64]) -> Result<StableStep> {
         let r = p.radius[i];
         let m = mass[i];
         if scene.model.is_hertzian() {
-            let t = contact::rayleigh_time_step(r, mat.density, mat.young_modulus, mat.poisson_ratio)?;
-            consider(t, &|| format!("Rayleigh step of particle {i} (r = {r} m, material {})", p.material[i]));
+            let t =
+                contact::rayleigh_time_step(r, mat.density, mat.young_modulus, mat.poisson_ratio)?;
+            consider(t, &|| {
+                format!(
+                    "Rayleigh step of particle {i} (r = {r} m, material {})",
+                    p.material[i]
+                )
+            });
         }
-        let mut partners: Vec<(usize, f64, f64, String)> = vec![(p.material[i], 0.5 * m, 0.5 * r, format!("particle {i} against its twin"))];
+        let mut partners: Vec<(usize, f64, f64, String)> = vec![(
+            p.material[i],
+            0.5 * m,
+            0.5 * r,
+            format!("particle {i} against its twin"),
+        )];
         for &wm in &wall_materials {
-            partners.push((wm, m, r, format!("particle {i} against a wall of material {wm}")));
+            partners.push((
+                wm,
+                m,
+                r,
+                format!("particle {i} against a wall of material {wm}"),
+            ));
         }
         for (other, m_star, r_star, what) in partners {
             let law = PairLaw::with_zeta(mat, &scene.materials[other], scene.model, 0.0)?;
             let (k_n, k_t) = match scene.model {
-                ContactModel::LinearSpringDashpot { normal_stiffness, tangential_stiffness } => {
-                    (normal_stiffness, tangential_stiffness)
-                }
+                ContactModel::LinearSpringDashpot {
+                    normal_stiffness,
+                    tangential_stiffness,
+                } => (normal_stiffness, tangential_stiffness),
                 _ => {
                     // Hertz bounds Hertz–Reissner from above (the shell only softens)
                     let k_h = contact::hertz_stiffness(r_star, law.e_star)?;
@@ -1272,11 +1420,15 @@ pub fn stable_time_step(scene: &Scene, mass: &[f64]) -> Result<StableStep> {
                 }
             };
             let dt_n = 0.5 * 2.0 * (m_star / k_n).sqrt();
-            consider(dt_n, &|| format!("normal contact stiffness, {what}, at {v} m/s"));
+            consider(dt_n, &|| {
+                format!("normal contact stiffness, {what}, at {v} m/s")
+            });
             if friction {
                 let m_t = if rotation { 2.0 / 7.0 * m_star } else { m_star };
                 let dt_t = 0.5 * 2.0 * (m_t / k_t).sqrt();
-                consider(dt_t, &|| format!("tangential contact stiffness, {what}, at {v} m/s"));
+                consider(dt_t, &|| {
+                    format!("tangential contact stiffness, {what}, at {v} m/s")
+                });
             }
         }
     }

@@ -56,10 +56,22 @@ pub fn walls() -> Result<Vec<Wall>> {
         Wall::fixed(WallShape::plane(Vec3::ZERO, Vec3::X)?, 0),
         Wall::fixed(WallShape::plane(Vec3::ZERO, Vec3::Y)?, 0),
         Wall::fixed(WallShape::plane(Vec3::new(0.0, WIDTH, 0.0), -Vec3::Y)?, 0),
-        Wall::fixed(WallShape::vertical_strip(xa, 0.0, xb, yc - OPENING / 2.0, 0.0, h)?, 0),
-        Wall::fixed(WallShape::vertical_strip(xa, WIDTH, xb, yc + OPENING / 2.0, 0.0, h)?, 0),
-        Wall::fixed(WallShape::vertical_strip(xb, yc - OPENING / 2.0, xe, yc - OPENING / 2.0, 0.0, h)?, 0),
-        Wall::fixed(WallShape::vertical_strip(xb, yc + OPENING / 2.0, xe, yc + OPENING / 2.0, 0.0, h)?, 0),
+        Wall::fixed(
+            WallShape::vertical_strip(xa, 0.0, xb, yc - OPENING / 2.0, 0.0, h)?,
+            0,
+        ),
+        Wall::fixed(
+            WallShape::vertical_strip(xa, WIDTH, xb, yc + OPENING / 2.0, 0.0, h)?,
+            0,
+        ),
+        Wall::fixed(
+            WallShape::vertical_strip(xb, yc - OPENING / 2.0, xe, yc - OPENING / 2.0, 0.0, h)?,
+            0,
+        ),
+        Wall::fixed(
+            WallShape::vertical_strip(xb, yc + OPENING / 2.0, xe, yc + OPENING / 2.0, 0.0, h)?,
+            0,
+        ),
         Wall::fixed(WallShape::plane(Vec3::new(xe, 0.0, 0.0), -Vec3::X)?, 0),
     ])
 }
@@ -132,7 +144,13 @@ pub fn anchor_scene(young_modulus: f64, start: TableStart) -> Result<Scene> {
     };
     let n = position.len();
     let particles = ParticleInit::at_rest(position, vec![DIAMETER / 2.0; n]);
-    let effects = EffectSet::of(&[Effect::Gravity, Effect::Belt, Effect::Friction, Effect::Rotation, Effect::Damping]);
+    let effects = EffectSet::of(&[
+        Effect::Gravity,
+        Effect::Belt,
+        Effect::Friction,
+        Effect::Rotation,
+        Effect::Damping,
+    ]);
     let mut scene = Scene::new(particles, vec![glass(young_modulus)], walls()?, effects);
     scene.time_step = Some(0.5 * DIAMETER / 2.0 * (2230.0 / young_modulus).sqrt());
     Ok(scene)

@@ -78,7 +78,10 @@ impl WallShape {
         if !(len > 0.0) {
             return Err(DemfemError::invalid("plane.normal length", len, "> 0"));
         }
-        Ok(WallShape::Plane { point, normal: normal / len })
+        Ok(WallShape::Plane {
+            point,
+            normal: normal / len,
+        })
     }
 
     /// A convex planar polygon from its vertices in boundary order (either orientation).
@@ -106,7 +109,11 @@ impl WallShape {
             .map(|v| (*v - vertices[0]).length())
             .fold(0.0_f64, f64::max);
         if !(area2 > 1e-12 * size * size) {
-            return Err(DemfemError::invalid("polygon area", 0.5 * area2, "> 0 (non-degenerate)"));
+            return Err(DemfemError::invalid(
+                "polygon area",
+                0.5 * area2,
+                "> 0 (non-degenerate)",
+            ));
         }
         let normal = nn / area2;
         let mut edge_normals = Vec::with_capacity(k);
@@ -140,14 +147,29 @@ impl WallShape {
                 }
             }
         }
-        Ok(WallShape::Polygon { vertices, normal, edge_normals })
+        Ok(WallShape::Polygon {
+            vertices,
+            normal,
+            edge_normals,
+        })
     }
 
     /// A vertical wall strip (rectangle) above the segment (x0, y0)–(x1, y1), from height
     /// `z_bottom` to `z_top`, m.
-    pub fn vertical_strip(x0: f64, y0: f64, x1: f64, y1: f64, z_bottom: f64, z_top: f64) -> Result<Self> {
+    pub fn vertical_strip(
+        x0: f64,
+        y0: f64,
+        x1: f64,
+        y1: f64,
+        z_bottom: f64,
+        z_top: f64,
+    ) -> Result<Self> {
         if !(z_top > z_bottom) {
-            return Err(DemfemError::invalid("strip z_top - z_bottom", z_top - z_bottom, "> 0"));
+            return Err(DemfemError::invalid(
+                "strip z_top - z_bottom",
+                z_top - z_bottom,
+                "> 0",
+            ));
         }
         WallShape::polygon(vec![
             Vec3::new(x0, y0, z_bottom),
@@ -163,7 +185,11 @@ impl WallShape {
         check_positive("cuboid.half_extents.x", half_extents.x)?;
         check_positive("cuboid.half_extents.y", half_extents.y)?;
         check_positive("cuboid.half_extents.z", half_extents.z)?;
-        Ok(WallShape::Cuboid { center, half_extents, shape: Cuboid::new(half_extents) })
+        Ok(WallShape::Cuboid {
+            center,
+            half_extents,
+            shape: Cuboid::new(half_extents),
+        })
     }
 
     /// Closest point of the wall (in its reference position) to `p`, and the unit normal of the
@@ -177,12 +203,16 @@ impl WallShape {
                 let d = normal.dot(p - *point);
                 Some((p - d * *normal, *normal, d))
             }
-            WallShape::Polygon { vertices, normal, edge_normals } => {
+            WallShape::Polygon {
+                vertices,
+                normal,
+                edge_normals,
+            } => {
                 let q = closest_on_convex_polygon(p, vertices, *normal, edge_normals);
                 let diff = p - q;
                 let dist = diff.length();
                 if dist > 0.0 {
-                    Some((q, diff / dist, dist))
+                    Some((q, diff * (1.0 / dist), dist))
                 } else {
                     None
                 }
@@ -209,7 +239,12 @@ impl WallShape {
 }
 
 /// Closest point to `p` on a convex planar polygon (boundary order, inward edge normals).
-fn closest_on_convex_polygon(p: Vec3, vertices: &[Vec3], normal: Vec3, edge_normals: &[Vec3]) -> Vec3 {
+fn closest_on_convex_polygon(
+    p: Vec3,
+    vertices: &[Vec3],
+    normal: Vec3,
+    edge_normals: &[Vec3],
+) -> Vec3 {
     let proj = p - normal.dot(p - vertices[0]) * normal;
     let k = vertices.len();
     let mut inside = true;
@@ -269,14 +304,23 @@ impl WallMotion {
         check_vec("harmonic.direction", direction)?;
         let len = direction.length();
         if !(len > 0.0) {
-            return Err(DemfemError::invalid("harmonic.direction length", len, "> 0"));
+            return Err(DemfemError::invalid(
+                "harmonic.direction length",
+                len,
+                "> 0",
+            ));
         }
         check_non_negative("harmonic.amplitude", amplitude)?;
         check_positive("harmonic.period", period)?;
         if !phase.is_finite() {
             return Err(DemfemError::invalid("harmonic.phase", phase, "finite"));
         }
-        Ok(WallMotion::Harmonic { direction: direction / len, amplitude, period, phase })
+        Ok(WallMotion::Harmonic {
+            direction: direction / len,
+            amplitude,
+            period,
+            phase,
+        })
     }
 
     /// Displacement from the reference position at time t, m, and velocity, m/s.
@@ -285,7 +329,12 @@ impl WallMotion {
         match *self {
             WallMotion::Fixed => (Vec3::ZERO, Vec3::ZERO),
             WallMotion::ConstantVelocity { velocity } => (velocity * t, velocity),
-            WallMotion::Harmonic { direction, amplitude, period, phase } => {
+            WallMotion::Harmonic {
+                direction,
+                amplitude,
+                period,
+                phase,
+            } => {
                 let w = 2.0 * std::f64::consts::PI / period;
                 let (s, c) = (w * t + phase).sin_cos();
                 (direction * (amplitude * s), direction * (amplitude * w * c))
@@ -307,7 +356,9 @@ impl WallMotion {
         match *self {
             WallMotion::Fixed => 0.0,
             WallMotion::ConstantVelocity { velocity } => velocity.length(),
-            WallMotion::Harmonic { amplitude, period, .. } => amplitude * 2.0 * std::f64::consts::PI / period,
+            WallMotion::Harmonic {
+                amplitude, period, ..
+            } => amplitude * 2.0 * std::f64::consts::PI / period,
         }
     }
 }
@@ -329,7 +380,12 @@ pub struct Wall {
 impl Wall {
     /// A fixed wall without surface velocity.
     pub fn fixed(shape: WallShape, material: usize) -> Self {
-        Wall { shape, motion: WallMotion::Fixed, surface_velocity: Vec3::ZERO, material }
+        Wall {
+            shape,
+            motion: WallMotion::Fixed,
+            surface_velocity: Vec3::ZERO,
+            material,
+        }
     }
 
     /// Validate the surface velocity (finite).
@@ -345,7 +401,9 @@ impl Wall {
     /// displacement `offset`, m.
     #[inline(always)]
     pub fn closest_at(&self, p: Vec3, offset: Vec3) -> Option<(Vec3, Vec3, f64)> {
-        self.shape.closest(p - offset).map(|(q, n, d)| (q + offset, n, d))
+        self.shape
+            .closest(p - offset)
+            .map(|(q, n, d)| (q + offset, n, d))
     }
 }
 
@@ -363,14 +421,20 @@ mod tests {
         let tri = Triangle::new(a, b, c);
         let mut s = 12345u64;
         let mut rnd = || {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             ((s >> 11) as f64 / (1u64 << 53) as f64) * 3.0 - 1.0
         };
         for _ in 0..2000 {
             let p = Vec3::new(rnd(), rnd(), rnd());
             let (q, _, d) = poly.closest(p).unwrap();
             let proj = tri.project_local_point(p, true);
-            assert!((q - proj.point).length() < 1e-12, "{p:?}: {q:?} vs {:?}", proj.point);
+            assert!(
+                (q - proj.point).length() < 1e-12,
+                "{p:?}: {q:?} vs {:?}",
+                proj.point
+            );
             assert!((d - (p - proj.point).length()).abs() < 1e-12);
         }
     }
