@@ -170,3 +170,24 @@ fn contact_onsets_are_logged_with_impact_velocity() {
         "{o:?}"
     );
 }
+
+/// A particle far from the others (1e200 m) must not break the cell grid (no overflow, no
+/// huge allocation): the step still runs and the near pair still collides.
+#[test]
+fn stray_far_particle_does_not_break_neighbour_search() {
+    let glass = material(45e9, 0.22, 2230.0, 0.0, 1.0);
+    let mut p = ParticleInit::at_rest(
+        vec![
+            Vec3::ZERO,
+            Vec3::new(0.016 + 1e-6, 0.0, 0.0),
+            Vec3::new(1e200, 0.0, 0.0),
+        ],
+        vec![0.008; 3],
+    );
+    p.velocity[0] = Vec3::new(0.1, 0.0, 0.0);
+    let mut s = Scene::new(p, vec![glass], vec![], EffectSet::empty());
+    s.gravity = Vec3::ZERO;
+    let mut sim = Simulation::new(&s).unwrap();
+    sim.step(3000).unwrap();
+    assert!(sim.velocities()[1].x > 0.09, "{:?}", sim.velocities()[1]);
+}

@@ -46,12 +46,10 @@ impl CellGrid {
         let extent = hi - lo;
         // keep the grid at most ~4 cells per particle so a far-away stray particle cannot blow
         // up memory; cells larger than needed only cost extra distance checks
+        // capped before the cast so a stray particle far away cannot overflow the count
         let dims = |c: f64| -> [usize; 3] {
-            [
-                (extent.x / c).floor() as usize + 1,
-                (extent.y / c).floor() as usize + 1,
-                (extent.z / c).floor() as usize + 1,
-            ]
+            let k = |e: f64| (e / c).floor().min(1e12) as usize + 1;
+            [k(extent.x), k(extent.y), k(extent.z)]
         };
         let mut d = dims(cell);
         while (d[0] as f64) * (d[1] as f64) * (d[2] as f64) > 4.0 * n_alive as f64 + 64.0 {
