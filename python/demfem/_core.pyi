@@ -81,6 +81,17 @@ class DemSimulation:
         record_every: int = 0,
         record_onsets: bool = False,
     ) -> None: ...
+    @staticmethod
+    def anchor_table(
+        young_modulus: float = 45e9,
+        start: str = "square",
+        threads: int = 1,
+        initial_vx: float = 0.0,
+        record_every: int = 0,
+        record_onsets: bool = False,
+    ) -> DemSimulation:
+        """The anchor table of shared/anchors/dem/scene.py at E (Pa); start 'square' or
+        'packed'; initial_vx (m/s) for every sphere."""
     def step(self, n: int, chunk: int = 2000) -> None:
         """Advance n steps (GIL released per chunk; Ctrl-C raises SimulationInterrupted)."""
     def run_until(self, t_end: float, chunk: int = 2000) -> int:

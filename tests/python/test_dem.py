@@ -60,3 +60,12 @@ def test_checkpoint_restart_is_bitwise_identical(tmp_path):
     b.step(3000)
     assert np.array_equal(a.positions(), b.positions())
     assert np.array_equal(a.angular_velocities(), b.angular_velocities())
+
+
+def test_anchor_table_runs_and_reports_state():
+    sim = dem.DemSimulation.anchor_table(1e8, start="packed", threads=2)
+    assert len(sim) == 840 and sim.dt == pytest.approx(0.5 * R * (2230.0 / 1e8) ** 0.5)
+    sim.step(200)
+    assert sim.positions().shape == (840, 3) and np.isfinite(sim.positions()).all()
+    assert sim.coordination().mean() > 1.0  # the dense packing touches
+    assert sim.riding_up_count() == 0

@@ -357,6 +357,39 @@ impl DemSimulation {
         Ok(DemSimulation { sim })
     }
 
+    /// The anchor accumulation table of `shared/anchors/dem/scene.py` (840 glass spheres of
+    /// 16 mm, belt 0.2 m/s, funnel with closed outlet, dt = 0.5 r √(ρ/E)) at Young's modulus
+    /// `young_modulus` (Pa). `start`: "square" (scene.py's 1 %-gap square packing at rest) or
+    /// "packed" (dense hexagonal packing against the funnel); `initial_vx` (m/s) sets every
+    /// sphere's x velocity.
+    #[staticmethod]
+    #[pyo3(signature = (young_modulus=45e9, start="square", threads=1, initial_vx=0.0, record_every=0, record_onsets=false))]
+    fn anchor_table(
+        py: Python<'_>,
+        young_modulus: f64,
+        start: &str,
+        threads: usize,
+        initial_vx: f64,
+        record_every: u64,
+        record_onsets: bool,
+    ) -> PyResult<Self> {
+        use demfem::dem::table::{anchor_scene, TableStart};
+        let start = match start {
+            "square" => TableStart::SquarePacking,
+            "packed" => TableStart::PackedIntoFunnel,
+            other => return Err(invalid("start", other, "'square' or 'packed'")),
+        };
+        let mut scene = anchor_scene(young_modulus, start).map_err(PyDemfemError::from)?;
+        for v in scene.particles.velocity.iter_mut() {
+            v.x = initial_vx;
+        }
+        scene.threads = threads;
+        scene.record_every = record_every;
+        scene.record_onsets = record_onsets;
+        let sim = py.detach(|| Simulation::new(&scene)).map_err(PyDemfemError::from)?;
+        Ok(DemSimulation { sim })
+    }
+
     /// Advance `n` steps, releasing the GIL in chunks of `chunk` steps; Ctrl-C between chunks
     /// raises SimulationInterrupted with the state consistent at a step boundary.
     #[pyo3(signature = (n, chunk=2000))]
