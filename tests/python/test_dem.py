@@ -65,7 +65,7 @@ def test_checkpoint_restart_is_bitwise_identical(tmp_path):
 def test_anchor_table_runs_and_reports_state():
     sim = dem.DemSimulation.anchor_table(1e8, start="packed", threads=2)
     assert len(sim) == 840 and sim.dt == pytest.approx(0.5 * R * (2230.0 / 1e8) ** 0.5)
-    sim.step(200)
+    sim.step(3000)  # the belt closes the 0.1 % gaps of the packing within ~40 ms
     assert sim.positions().shape == (840, 3) and np.isfinite(sim.positions()).all()
-    assert sim.coordination().mean() > 1.0  # the dense packing touches
+    assert sim.coordination().mean() > 1.0
     assert sim.riding_up_count() == 0
