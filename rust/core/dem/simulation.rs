@@ -27,8 +27,8 @@ use crate::geometry::{Vec3, Wall};
 /// Below this many particles the step runs on the calling thread whatever `threads` says:
 /// a rayon fork-join costs microseconds, as much as the whole step of a small system.
 pub const PARALLEL_MIN_PARTICLES: usize = 256;
-const PAIR_CHUNK: usize = 512;
-const PARTICLE_CHUNK: usize = 128;
+const PAIR_CHUNK: usize = 256;
+const PARTICLE_CHUNK: usize = 64;
 const NO_WALL: u32 = u32::MAX;
 
 /// A candidate particle pair of the Verlet list with its contact state. `repr(C)` with the
