@@ -191,3 +191,42 @@ fn stray_far_particle_does_not_break_neighbour_search() {
     sim.step(3000).unwrap();
     assert!(sim.velocities()[1].x > 0.09, "{:?}", sim.velocities()[1]);
 }
+
+/// The outlet: a sphere carried by the belt past the removal plane x = 0.02 m is removed
+/// (alive = false, logged with its time) and stops moving; one that stays is kept.
+#[test]
+fn particles_past_the_outlet_plane_are_removed() {
+    let glass = material(45e9, 0.22, 2230.0, 0.2, 0.5);
+    let effects = EffectSet::of(&[
+        Effect::Gravity,
+        Effect::Belt,
+        Effect::Friction,
+        Effect::Rotation,
+        Effect::Damping,
+    ]);
+    let mut s = sphere_on_floor(
+        0.008,
+        0.008,
+        Vec3::new(0.2, 0.0, 0.0),
+        Vec3::ZERO,
+        vec![glass, glass],
+        effects,
+    );
+    s.particles.position.push(Vec3::new(-0.05, 0.0, 0.008));
+    s.particles.velocity.push(Vec3::ZERO);
+    s.particles.angular_velocity.push(Vec3::ZERO);
+    s.particles.radius.push(0.008);
+    s.particles.material.push(0);
+    s.particles.tag.push(1);
+    s.gravity = Vec3::new(0.0, 0.0, -9.81);
+    s.walls[0].surface_velocity = Vec3::new(0.2, 0.0, 0.0);
+    s.removal_plane = Some((Vec3::new(0.02, 0.0, 0.0), -Vec3::X));
+    let mut sim = Simulation::new(&s).unwrap();
+    sim.run_until(0.5).unwrap();
+    assert_eq!(sim.alive(), &[false, true]);
+    assert_eq!(sim.removals().len(), 1);
+    let (t, i) = sim.removals()[0];
+    assert_eq!(i, 0);
+    // it reached x = 0.02 m at no less than 0.1 s (speed ≤ 0.2 m/s) and was removed soon after
+    assert!(t > 0.1 && t < 0.5, "removed at {t}");
+}

@@ -80,7 +80,10 @@ class DemSimulation:
         overlap_tolerance: float = 0.01,
         record_every: int = 0,
         record_onsets: bool = False,
+        removal_plane: Optional[tuple[tuple[float, float, float], tuple[float, float, float]]] = None,
     ) -> None: ...
+    def removals(self) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint32]]:
+        """Particles removed through the outlet plane: times (s) and indices."""
     @staticmethod
     def anchor_table(
         young_modulus: float = 45e9,

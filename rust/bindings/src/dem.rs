@@ -230,7 +230,7 @@ impl DemSimulation {
         material_ids=None, tags=None, gravity=(0.0, 0.0, -9.81), model="hertz_mindlin",
         linear_stiffness=None, clamp_normal_force=true, dt=None, dt_safety=0.2,
         expected_max_speed=1.0, skin=None, threads=1, overlap_tolerance=0.01, record_every=0,
-        record_onsets=false
+        record_onsets=false, removal_plane=None
     ))]
     #[allow(clippy::too_many_arguments)]
     fn new(
@@ -256,6 +256,7 @@ impl DemSimulation {
         overlap_tolerance: f64,
         record_every: u64,
         record_onsets: bool,
+        removal_plane: Option<((f64, f64, f64), (f64, f64, f64))>,
     ) -> PyResult<Self> {
         let position = vec3s("positions", &positions, None)?;
         let n = position.len();
@@ -386,8 +387,21 @@ impl DemSimulation {
         scene.threads = threads;
         scene.record_every = record_every;
         scene.record_onsets = record_onsets;
-        let sim = py.detach(|| Simulation::new(&scene)).map_err(PyDemfemError::from)?;
+        scene.removal_plane =
+            removal_plane.map(|(p, n)| (Vec3::new(p.0, p.1, p.2), Vec3::new(n.0, n.1, n.2)));
+        let sim = py
+            .detach(|| Simulation::new(&scene))
+            .map_err(PyDemfemError::from)?;
         Ok(DemSimulation { sim })
+    }
+
+    /// Particles removed through the outlet plane: (times (s), indices).
+    fn removals<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<u32>>) {
+        let (t, i): (Vec<f64>, Vec<u32>) = self.sim.removals().iter().copied().unzip();
+        (t.into_pyarray(py), i.into_pyarray(py))
     }
 
     /// Advance `n` steps, releasing the GIL in chunks of `chunk` steps; Ctrl-C between chunks

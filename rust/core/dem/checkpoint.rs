@@ -122,6 +122,7 @@ impl Simulation {
         h.f64(self.dt);
         h.f64(self.skin);
         h.bytes(&[self.clamp as u8]);
+        h.bytes(format!("{:?}", self.removal_plane).as_bytes());
         h.0
     }
 

@@ -83,6 +83,10 @@ pub struct Scene {
     pub record_every: u64,
     /// Log every contact onset.
     pub record_onsets: bool,
+    /// Outlet: a particle whose centre lies behind this plane (point, normal towards the
+    /// kept side; m) is removed at the next neighbour-list rebuild (a particle leaving moves
+    /// and soon triggers one). `None`: nothing is removed.
+    pub removal_plane: Option<(Vec3, Vec3)>,
 }
 
 impl Scene {
@@ -111,6 +115,7 @@ impl Scene {
             initial_overlap_tolerance: 0.01,
             record_every: 0,
             record_onsets: false,
+            removal_plane: None,
         }
     }
 
@@ -197,6 +202,15 @@ impl Scene {
             return Err(DemfemError::invalid("threads", 0.0, ">= 1"));
         }
         check_non_negative("initial_overlap_tolerance", self.initial_overlap_tolerance)?;
+        if let Some((point, normal)) = self.removal_plane {
+            if !(point.is_finite() && normal.is_finite() && normal.length() > 0.0) {
+                return Err(DemfemError::InvalidParameter {
+                    field: "removal_plane".into(),
+                    value: format!("{point:?}, {normal:?}"),
+                    allowed: "a finite point and a finite non-zero normal".into(),
+                });
+            }
+        }
         self.check_effects()
     }
 

@@ -145,6 +145,8 @@ pub struct Simulation {
     pub(crate) threads: usize,
     pub(crate) record_every: u64,
     pub(crate) record_onsets: bool,
+    /// Outlet plane (point, unit normal towards the kept side).
+    pub(crate) removal_plane: Option<(Vec3, Vec3)>,
     // ---- dynamic state (what a checkpoint holds)
     pub(crate) position: Vec<Vec3>,
     pub(crate) velocity: Vec<Vec3>,
@@ -177,6 +179,8 @@ pub struct Simulation {
     pub(crate) frames: Vec<Frame>,
     pub(crate) onsets: Vec<ContactOnset>,
     pub(crate) rebuilds: u64,
+    /// (time, particle) of every removal through the outlet plane.
+    pub(crate) removals: Vec<(f64, u32)>,
 }
 
 impl std::fmt::Debug for Simulation {
@@ -703,6 +707,7 @@ impl Simulation {
             threads: scene.threads,
             record_every: scene.record_every,
             record_onsets: scene.record_onsets,
+            removal_plane: scene.removal_plane.map(|(p, n)| (p, n / n.length())),
             position: p.position.clone(),
             velocity: p.velocity.clone(),
             omega: p.angular_velocity.clone(),
@@ -732,6 +737,7 @@ impl Simulation {
             frames: Vec::new(),
             onsets: Vec::new(),
             rebuilds: 0,
+            removals: Vec::new(),
         };
         sim.refresh_wall_state();
         sim.rebuild();
@@ -818,6 +824,14 @@ impl Simulation {
     pub(crate) fn rebuild(&mut self) {
         let n = self.position.len();
         self.rebuilds += 1;
+        if let Some((point, normal)) = self.removal_plane {
+            for i in 0..n {
+                if self.alive[i] && normal.dot(self.position[i] - point) < 0.0 {
+                    self.alive[i] = false;
+                    self.removals.push((self.time, i as u32));
+                }
+            }
+        }
         // ---- particle pairs
         self.grid.candidate_pairs(
             &self.position,
@@ -1292,6 +1306,11 @@ impl Simulation {
         } else {
             None
         }
+    }
+
+    /// (time in s, particle index) of every particle removed through the outlet plane.
+    pub fn removals(&self) -> &[(f64, u32)] {
+        &self.removals
     }
 
     /// Remove particle `i` from the simulation (it stops interacting and moving).
