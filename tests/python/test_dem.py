@@ -69,3 +69,12 @@ def test_anchor_table_runs_and_reports_state():
     assert sim.positions().shape == (840, 3) and np.isfinite(sim.positions()).all()
     assert sim.coordination().mean() > 1.0
     assert sim.riding_up_count() == 0
+
+
+def test_outlet_plane_removes_particles():
+    belt = dem.plane((0, 0, 0), (0, 0, 1), surface_velocity=(0.2, 0, 0))
+    sim = dem.DemSimulation(np.array([[0.0, 0.0, R]]), np.array([R]), [GLASS], [belt], TABLE_EFFECTS,
+                            velocities=np.array([[0.2, 0.0, 0.0]]), removal_plane=((0.02, 0, 0), (-1, 0, 0)))
+    sim.run_until(0.5)
+    times, idx = sim.removals()
+    assert list(idx) == [0] and not sim.alive()[0] and 0.1 < times[0] < 0.5

@@ -352,6 +352,8 @@ impl DemSimulation {
         scene.initial_overlap_tolerance = overlap_tolerance;
         scene.record_every = record_every;
         scene.record_onsets = record_onsets;
+        scene.removal_plane =
+            removal_plane.map(|(p, n)| (Vec3::new(p.0, p.1, p.2), Vec3::new(n.0, n.1, n.2)));
         let sim = py
             .detach(|| Simulation::new(&scene))
             .map_err(PyDemfemError::from)?;
@@ -387,8 +389,6 @@ impl DemSimulation {
         scene.threads = threads;
         scene.record_every = record_every;
         scene.record_onsets = record_onsets;
-        scene.removal_plane =
-            removal_plane.map(|(p, n)| (Vec3::new(p.0, p.1, p.2), Vec3::new(n.0, n.1, n.2)));
         let sim = py
             .detach(|| Simulation::new(&scene))
             .map_err(PyDemfemError::from)?;
