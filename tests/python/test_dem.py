@@ -78,3 +78,20 @@ def test_outlet_plane_removes_particles():
     sim.run_until(0.5)
     times, idx = sim.removals()
     assert list(idx) == [0] and not sim.alive()[0] and 0.1 < times[0] < 0.5
+
+
+def test_ctrl_c_stops_cleanly_at_a_chunk_boundary():
+    import _thread
+    import threading
+
+    from demfem.errors import SimulationInterrupted
+
+    sim = dem.DemSimulation.anchor_table(1e8, start="square")
+    timer = threading.Timer(0.3, _thread.interrupt_main)  # what Ctrl-C does
+    timer.start()
+    with pytest.raises(SimulationInterrupted):
+        sim.step(10_000_000, chunk=100)
+    timer.cancel()
+    assert sim.steps % 100 == 0 and 0 < sim.steps < 10_000_000
+    assert np.isfinite(sim.positions()).all()
+    sim.step(100)  # and the simulation goes on
