@@ -1,9 +1,15 @@
 """Hand-written stubs of the compiled core (checked by ``mypy.stubtest``). SI units."""
+from __future__ import annotations
+
+from os import PathLike
+from typing import Any, Optional, Sequence, final
+
 import numpy as np
 import numpy.typing as npt
 
 __version__: str
 __all__ = [
+    "DemSimulation",
     "__version__",
     "hertz_contact_duration",
     "max_impact_force",
@@ -39,3 +45,113 @@ def rayleigh_time_step(radius: float, density: float, e: float, nu: float) -> fl
 
 def hertz_contact_duration(k_h: float, m_star: float, v_rel: float) -> float:
     """Duration (s) of an undamped Hertz impact: k_h (N/m^1.5), m_star (kg), v_rel (m/s)."""
+
+@final
+class DemSimulation:
+    """A DEM simulation of spheres and walls.
+
+    positions (N, 3) m; radii (N,) m; materials: list of dicts with young_modulus (Pa),
+    poisson_ratio, density (kg/m^3), friction, restitution, rolling_friction, shell_stiffness
+    (N/m); walls: list of dicts with type 'plane' (point, normal), 'polygon' (vertices),
+    'strip' (x0, y0, x1, y1, z_bottom, z_top) or 'cuboid' (center, half_extents), plus material,
+    surface_velocity (m/s) and motion ({'type': 'constant', 'velocity'} or
+    {'type': 'harmonic', 'direction', 'amplitude' (m), 'period' (s), 'phase' (rad)});
+    effects: names from gravity, belt, moving_walls, friction, rotation, damping,
+    rolling_resistance, planar. gravity (m/s^2) defaults to (0, 0, -9.81). dt (s) defaults
+    to dt_safety x the stable limit; a larger one
+    raises UnstableTimeStepError.
+    """
+
+    def __new__(
+        cls,
+        positions: npt.NDArray[np.float64],
+        radii: npt.NDArray[np.float64],
+        materials: list[dict[str, float]],
+        walls: list[dict[str, Any]],
+        effects: Sequence[str],
+        *,
+        velocities: Optional[npt.NDArray[np.float64]] = None,
+        angular_velocities: Optional[npt.NDArray[np.float64]] = None,
+        material_ids: Optional[npt.NDArray[np.int64]] = None,
+        tags: Optional[npt.NDArray[np.int64]] = None,
+        gravity: tuple[float, float, float] = ...,
+        model: str = "hertz_mindlin",
+        linear_stiffness: Optional[tuple[float, float]] = None,
+        clamp_normal_force: bool = True,
+        dt: Optional[float] = None,
+        dt_safety: float = 0.2,
+        expected_max_speed: float = 1.0,
+        skin: Optional[float] = None,
+        threads: int = 1,
+        overlap_tolerance: float = 0.01,
+        record_every: int = 0,
+        record_onsets: bool = False,
+        removal_plane: Optional[tuple[tuple[float, float, float], tuple[float, float, float]]] = None,
+    ) -> DemSimulation: ...
+    def removals(self) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint32]]:
+        """Particles removed through the outlet plane: times (s) and indices."""
+    @staticmethod
+    def anchor_table(
+        young_modulus: float = 45e9,
+        start: str = "square",
+        threads: int = 1,
+        initial_vx: float = 0.0,
+        record_every: int = 0,
+        record_onsets: bool = False,
+    ) -> DemSimulation:
+        """The anchor table of shared/anchors/dem/scene.py at E (Pa); start 'square' or
+        'packed'; initial_vx (m/s) for every sphere."""
+    def step(self, n: int, chunk: int = 2000) -> None:
+        """Advance n steps (GIL released per chunk; Ctrl-C raises SimulationInterrupted)."""
+    def run_until(self, t_end: float, chunk: int = 2000) -> int:
+        """Advance to simulated time t_end (s); returns the steps taken."""
+    @property
+    def time(self) -> float:
+        """Simulated time, s."""
+    @property
+    def steps(self) -> int: ...
+    @property
+    def dt(self) -> float:
+        """Time step, s."""
+    @property
+    def stable_dt(self) -> float:
+        """Stable time-step limit, s."""
+    @property
+    def stable_dt_reason(self) -> str: ...
+    @property
+    def effects(self) -> list[str]: ...
+    def __len__(self) -> int: ...
+    def positions(self) -> npt.NDArray[np.float64]:
+        """Centres, m, (N, 3)."""
+    def velocities(self) -> npt.NDArray[np.float64]:
+        """Velocities (half step), m/s, (N, 3)."""
+    def angular_velocities(self) -> npt.NDArray[np.float64]:
+        """Angular velocities (half step), rad/s, (N, 3)."""
+    def contact_force_sums(self) -> npt.NDArray[np.float64]:
+        """Sum of contact forces per particle, N, (N, 3)."""
+    def radii(self) -> npt.NDArray[np.float64]: ...
+    def masses(self) -> npt.NDArray[np.float64]:
+        """Masses, kg."""
+    def coordination(self) -> npt.NDArray[np.uint32]: ...
+    def wall_contacts(self) -> npt.NDArray[np.uint32]: ...
+    def tags(self) -> npt.NDArray[np.uint32]: ...
+    def alive(self) -> npt.NDArray[np.bool_]: ...
+    def kinetic_energy(self) -> float:
+        """Kinetic energy, J."""
+    def max_overlap(self) -> float:
+        """Largest overlap, m."""
+    def riding_up_count(self, floor_z: float = 0.0, tolerance: float = 0.002) -> int:
+        """Spheres whose centre is above floor_z + radius + tolerance (m)."""
+    def remove_particle(self, i: int) -> None: ...
+    def frames(self) -> dict[str, npt.NDArray[Any]]:
+        """time (F,), step (F,), positions/velocities/angular_velocities/contact_force_sums
+        (F, N, 3), coordination/wall_contacts (F, N)."""
+    def onsets(self) -> dict[str, npt.NDArray[Any]]:
+        """Contact onsets: time (s), step, particle, partner, partner_is_wall, normal_speed,
+        tangential_speed (m/s), position, partner_position (K, 3) (m)."""
+    def contacts(self) -> dict[str, npt.NDArray[Any]]:
+        """Active contacts: particle, partner, partner_is_wall, normal (K, 3), normal_force (N),
+        tangential_force (K, 3) (N), overlap (m), point (K, 3) (m)."""
+    def clear_records(self) -> None: ...
+    def save_checkpoint(self, path: str | PathLike[str]) -> None: ...
+    def load_checkpoint(self, path: str | PathLike[str]) -> None: ...

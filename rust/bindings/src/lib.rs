@@ -9,6 +9,8 @@ use pyo3::types::PyType;
 use demfem::contact::{self, ForceClamp, NormalLaw};
 use demfem::DemfemError;
 
+mod dem;
+
 /// The one conversion from core errors to Python exceptions: each variant raises the class
 /// of the same name from `demfem.errors` (pure Python, so that bad input is both a
 /// `DemfemError` and a `ValueError`).
@@ -153,5 +155,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(tsuji_damping_for_restitution, m)?)?;
     m.add_function(wrap_pyfunction!(rayleigh_time_step, m)?)?;
     m.add_function(wrap_pyfunction!(hertz_contact_duration, m)?)?;
+    dem::register(m)?;
     Ok(())
 }

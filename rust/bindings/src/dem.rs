@@ -1,0 +1,742 @@
+//! Python binding of the DEM engine: `DemSimulation`, built from plain arrays and dicts,
+//! stepping with the GIL released in chunks so Ctrl-C stops a run cleanly at a step
+//! boundary; state and records come back as numpy arrays. SI units throughout.
+
+use std::path::PathBuf;
+
+use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+
+use demfem::dem::{ContactModel, EffectSet, Material, ParticleInit, Partner, Scene, Simulation};
+use demfem::geometry::{Vec3, Wall, WallMotion, WallShape};
+use demfem::DemfemError;
+
+use crate::{CoreResult, PyDemfemError};
+
+fn shape_err(field: &str, detail: String) -> PyErr {
+    PyDemfemError::from(DemfemError::ShapeMismatch {
+        field: field.into(),
+        detail,
+    })
+    .into()
+}
+
+fn invalid(field: &str, value: &str, allowed: &str) -> PyErr {
+    PyDemfemError::from(DemfemError::InvalidParameter {
+        field: field.into(),
+        value: value.into(),
+        allowed: allowed.into(),
+    })
+    .into()
+}
+
+fn vec3s(field: &str, a: &PyReadonlyArray2<'_, f64>, n: Option<usize>) -> PyResult<Vec<Vec3>> {
+    let v = a.as_array();
+    let s = v.shape();
+    if s[1] != 3 || n.is_some_and(|n| n != s[0]) {
+        return Err(shape_err(
+            field,
+            format!(
+                "expected ({}, 3), got ({}, {})",
+                n.map_or("N".into(), |n| n.to_string()),
+                s[0],
+                s[1]
+            ),
+        ));
+    }
+    Ok(v.outer_iter()
+        .map(|r| Vec3::new(r[0], r[1], r[2]))
+        .collect())
+}
+
+fn get_f64(d: &Bound<'_, PyDict>, key: &str, default: Option<f64>, what: &str) -> PyResult<f64> {
+    match d.get_item(key)? {
+        Some(v) => v
+            .extract::<f64>()
+            .map_err(|_| invalid(&format!("{what}.{key}"), &v.to_string(), "a number")),
+        None => default.ok_or_else(|| invalid(&format!("{what}.{key}"), "missing", "required")),
+    }
+}
+
+fn get_vec3(d: &Bound<'_, PyDict>, key: &str, default: Option<Vec3>, what: &str) -> PyResult<Vec3> {
+    match d.get_item(key)? {
+        Some(v) => {
+            let x: Vec<f64> = v
+                .extract()
+                .map_err(|_| invalid(&format!("{what}.{key}"), &v.to_string(), "3 numbers"))?;
+            if x.len() != 3 {
+                return Err(shape_err(
+                    &format!("{what}.{key}"),
+                    format!("expected 3 components, got {}", x.len()),
+                ));
+            }
+            Ok(Vec3::new(x[0], x[1], x[2]))
+        }
+        None => default.ok_or_else(|| invalid(&format!("{what}.{key}"), "missing", "required")),
+    }
+}
+
+fn parse_material(d: &Bound<'_, PyDict>, k: usize) -> PyResult<Material> {
+    let w = format!("materials[{k}]");
+    Ok(Material {
+        young_modulus: get_f64(d, "young_modulus", None, &w)?,
+        poisson_ratio: get_f64(d, "poisson_ratio", None, &w)?,
+        density: get_f64(d, "density", None, &w)?,
+        friction: get_f64(d, "friction", Some(0.0), &w)?,
+        restitution: get_f64(d, "restitution", Some(1.0), &w)?,
+        rolling_friction: get_f64(d, "rolling_friction", Some(0.0), &w)?,
+        shell_stiffness: get_f64(d, "shell_stiffness", Some(f64::INFINITY), &w)?,
+    })
+}
+
+fn parse_wall(d: &Bound<'_, PyDict>, k: usize) -> PyResult<Wall> {
+    let w = format!("walls[{k}]");
+    let kind: String = match d.get_item("type")? {
+        Some(t) => t.extract()?,
+        None => {
+            return Err(invalid(
+                &format!("{w}.type"),
+                "missing",
+                "'plane', 'polygon', 'strip' or 'cuboid'",
+            ))
+        }
+    };
+    let shape = match kind.as_str() {
+        "plane" => WallShape::plane(
+            get_vec3(d, "point", None, &w)?,
+            get_vec3(d, "normal", None, &w)?,
+        ),
+        "polygon" => {
+            let verts: Vec<Vec<f64>> = match d.get_item("vertices")? {
+                Some(v) => v.extract()?,
+                None => return Err(invalid(&format!("{w}.vertices"), "missing", "required")),
+            };
+            let mut out = Vec::with_capacity(verts.len());
+            for v in verts {
+                if v.len() != 3 {
+                    return Err(shape_err(
+                        &format!("{w}.vertices"),
+                        format!("vertex with {} components", v.len()),
+                    ));
+                }
+                out.push(Vec3::new(v[0], v[1], v[2]));
+            }
+            WallShape::polygon(out)
+        }
+        "strip" => WallShape::vertical_strip(
+            get_f64(d, "x0", None, &w)?,
+            get_f64(d, "y0", None, &w)?,
+            get_f64(d, "x1", None, &w)?,
+            get_f64(d, "y1", None, &w)?,
+            get_f64(d, "z_bottom", None, &w)?,
+            get_f64(d, "z_top", None, &w)?,
+        ),
+        "cuboid" => WallShape::cuboid(
+            get_vec3(d, "center", None, &w)?,
+            get_vec3(d, "half_extents", None, &w)?,
+        ),
+        other => {
+            return Err(invalid(
+                &format!("{w}.type"),
+                other,
+                "'plane', 'polygon', 'strip' or 'cuboid'",
+            ))
+        }
+    }
+    .map_err(PyDemfemError::from)?;
+    let motion = match d.get_item("motion")? {
+        None => WallMotion::Fixed,
+        Some(m) if m.is_none() => WallMotion::Fixed,
+        Some(m) => {
+            let m = m
+                .cast_into::<PyDict>()
+                .map_err(|_| invalid(&format!("{w}.motion"), "not a dict", "a dict or None"))?;
+            let mw = format!("{w}.motion");
+            let t: String = match m.get_item("type")? {
+                Some(t) => t.extract()?,
+                None => {
+                    return Err(invalid(
+                        &format!("{mw}.type"),
+                        "missing",
+                        "'constant' or 'harmonic'",
+                    ))
+                }
+            };
+            match t.as_str() {
+                "fixed" => WallMotion::Fixed,
+                "constant" => WallMotion::ConstantVelocity {
+                    velocity: get_vec3(&m, "velocity", None, &mw)?,
+                },
+                "harmonic" => WallMotion::harmonic(
+                    get_vec3(&m, "direction", None, &mw)?,
+                    get_f64(&m, "amplitude", None, &mw)?,
+                    get_f64(&m, "period", None, &mw)?,
+                    get_f64(&m, "phase", Some(0.0), &mw)?,
+                )
+                .map_err(PyDemfemError::from)?,
+                other => {
+                    return Err(invalid(
+                        &format!("{mw}.type"),
+                        other,
+                        "'fixed', 'constant' or 'harmonic'",
+                    ))
+                }
+            }
+        }
+    };
+    let material: i64 = match d.get_item("material")? {
+        Some(m) => m.extract()?,
+        None => 0,
+    };
+    if material < 0 {
+        return Err(invalid(
+            &format!("{w}.material"),
+            &material.to_string(),
+            ">= 0",
+        ));
+    }
+    Ok(Wall {
+        shape,
+        motion,
+        surface_velocity: get_vec3(d, "surface_velocity", Some(Vec3::ZERO), &w)?,
+        material: material as usize,
+    })
+}
+
+fn flat3(v: &[Vec3]) -> Vec<f64> {
+    let mut out = Vec::with_capacity(3 * v.len());
+    for x in v {
+        out.extend([x.x, x.y, x.z]);
+    }
+    out
+}
+
+fn array_n3<'py>(py: Python<'py>, v: &[Vec3]) -> PyResult<Bound<'py, PyAny>> {
+    Ok(flat3(v).into_pyarray(py).reshape([v.len(), 3])?.into_any())
+}
+
+/// A DEM simulation of spheres and walls (see `demfem._core.pyi` for the full signature).
+#[pyclass(module = "demfem._core")]
+pub struct DemSimulation {
+    sim: Simulation,
+}
+
+#[pymethods]
+impl DemSimulation {
+    #[new]
+    #[pyo3(signature = (
+        positions, radii, materials, walls, effects, *, velocities=None, angular_velocities=None,
+        material_ids=None, tags=None, gravity=(0.0, 0.0, -9.81), model="hertz_mindlin",
+        linear_stiffness=None, clamp_normal_force=true, dt=None, dt_safety=0.2,
+        expected_max_speed=1.0, skin=None, threads=1, overlap_tolerance=0.01, record_every=0,
+        record_onsets=false, removal_plane=None
+    ))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        py: Python<'_>,
+        positions: PyReadonlyArray2<'_, f64>,
+        radii: PyReadonlyArray1<'_, f64>,
+        materials: &Bound<'_, PyList>,
+        walls: &Bound<'_, PyList>,
+        effects: Vec<String>,
+        velocities: Option<PyReadonlyArray2<'_, f64>>,
+        angular_velocities: Option<PyReadonlyArray2<'_, f64>>,
+        material_ids: Option<PyReadonlyArray1<'_, i64>>,
+        tags: Option<PyReadonlyArray1<'_, i64>>,
+        gravity: (f64, f64, f64),
+        model: &str,
+        linear_stiffness: Option<(f64, f64)>,
+        clamp_normal_force: bool,
+        dt: Option<f64>,
+        dt_safety: f64,
+        expected_max_speed: f64,
+        skin: Option<f64>,
+        threads: usize,
+        overlap_tolerance: f64,
+        record_every: u64,
+        record_onsets: bool,
+        removal_plane: Option<((f64, f64, f64), (f64, f64, f64))>,
+    ) -> PyResult<Self> {
+        let position = vec3s("positions", &positions, None)?;
+        let n = position.len();
+        let radius: Vec<f64> = radii.as_array().to_vec();
+        if radius.len() != n {
+            return Err(shape_err(
+                "radii",
+                format!("{} entries for {n} particles", radius.len()),
+            ));
+        }
+        let mut p = ParticleInit::at_rest(position, radius);
+        if let Some(v) = velocities {
+            p.velocity = vec3s("velocities", &v, Some(n))?;
+        }
+        if let Some(w) = angular_velocities {
+            p.angular_velocity = vec3s("angular_velocities", &w, Some(n))?;
+        }
+        if let Some(m) = material_ids {
+            let m = m.as_array();
+            if m.len() != n {
+                return Err(shape_err(
+                    "material_ids",
+                    format!("{} entries for {n} particles", m.len()),
+                ));
+            }
+            p.material = m
+                .iter()
+                .map(|&x| {
+                    usize::try_from(x).map_err(|_| invalid("material_ids", &x.to_string(), ">= 0"))
+                })
+                .collect::<PyResult<_>>()?;
+        }
+        if let Some(t) = tags {
+            let t = t.as_array();
+            if t.len() != n {
+                return Err(shape_err(
+                    "tags",
+                    format!("{} entries for {n} particles", t.len()),
+                ));
+            }
+            p.tag = t
+                .iter()
+                .map(|&x| {
+                    u32::try_from(x).map_err(|_| invalid("tags", &x.to_string(), "in [0, 2^32)"))
+                })
+                .collect::<PyResult<_>>()?;
+        }
+        let mut mats = Vec::new();
+        for (k, m) in materials.iter().enumerate() {
+            let d = m
+                .cast_into::<PyDict>()
+                .map_err(|_| invalid(&format!("materials[{k}]"), "not a dict", "a dict"))?;
+            mats.push(parse_material(&d, k)?);
+        }
+        let mut ws = Vec::new();
+        for (k, w) in walls.iter().enumerate() {
+            let d = w
+                .cast_into::<PyDict>()
+                .map_err(|_| invalid(&format!("walls[{k}]"), "not a dict", "a dict"))?;
+            ws.push(parse_wall(&d, k)?);
+        }
+        let effects = EffectSet::parse(&effects).map_err(PyDemfemError::from)?;
+        let mut scene = Scene::new(p, mats, ws, effects);
+        scene.gravity = Vec3::new(gravity.0, gravity.1, gravity.2);
+        scene.model = match (model, linear_stiffness) {
+            ("hertz_mindlin", _) => ContactModel::HertzMindlin,
+            ("hertz_reissner_mindlin", _) => ContactModel::HertzReissnerMindlin,
+            ("linear", Some((kn, kt))) => ContactModel::LinearSpringDashpot {
+                normal_stiffness: kn,
+                tangential_stiffness: kt,
+            },
+            ("linear", None) => {
+                return Err(invalid(
+                    "linear_stiffness",
+                    "None",
+                    "(k_n, k_t) in N/m for model='linear'",
+                ))
+            }
+            (other, _) => {
+                return Err(invalid(
+                    "model",
+                    other,
+                    "'hertz_mindlin', 'hertz_reissner_mindlin' or 'linear'",
+                ))
+            }
+        };
+        scene.clamp_normal_force = clamp_normal_force;
+        scene.time_step = dt;
+        scene.time_step_safety = dt_safety;
+        scene.expected_max_speed = expected_max_speed;
+        scene.skin = skin;
+        scene.threads = threads;
+        scene.initial_overlap_tolerance = overlap_tolerance;
+        scene.record_every = record_every;
+        scene.record_onsets = record_onsets;
+        scene.removal_plane =
+            removal_plane.map(|(p, n)| (Vec3::new(p.0, p.1, p.2), Vec3::new(n.0, n.1, n.2)));
+        let sim = py
+            .detach(|| Simulation::new(&scene))
+            .map_err(PyDemfemError::from)?;
+        Ok(DemSimulation { sim })
+    }
+
+    /// The anchor accumulation table of `shared/anchors/dem/scene.py` (840 glass spheres of
+    /// 16 mm, belt 0.2 m/s, funnel with closed outlet, dt = 0.5 r √(ρ/E)) at Young's modulus
+    /// `young_modulus` (Pa). `start`: "square" (scene.py's 1 %-gap square packing at rest) or
+    /// "packed" (dense hexagonal packing against the funnel); `initial_vx` (m/s) sets every
+    /// sphere's x velocity.
+    #[staticmethod]
+    #[pyo3(signature = (young_modulus=45e9, start="square", threads=1, initial_vx=0.0, record_every=0, record_onsets=false))]
+    fn anchor_table(
+        py: Python<'_>,
+        young_modulus: f64,
+        start: &str,
+        threads: usize,
+        initial_vx: f64,
+        record_every: u64,
+        record_onsets: bool,
+    ) -> PyResult<Self> {
+        use demfem::dem::table::{anchor_scene, TableStart};
+        let start = match start {
+            "square" => TableStart::SquarePacking,
+            "packed" => TableStart::PackedIntoFunnel,
+            other => return Err(invalid("start", other, "'square' or 'packed'")),
+        };
+        let mut scene = anchor_scene(young_modulus, start).map_err(PyDemfemError::from)?;
+        for v in scene.particles.velocity.iter_mut() {
+            v.x = initial_vx;
+        }
+        scene.threads = threads;
+        scene.record_every = record_every;
+        scene.record_onsets = record_onsets;
+        let sim = py
+            .detach(|| Simulation::new(&scene))
+            .map_err(PyDemfemError::from)?;
+        Ok(DemSimulation { sim })
+    }
+
+    /// Particles removed through the outlet plane: (times (s), indices).
+    fn removals<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<u32>>) {
+        let (t, i): (Vec<f64>, Vec<u32>) = self.sim.removals().iter().copied().unzip();
+        (t.into_pyarray(py), i.into_pyarray(py))
+    }
+
+    /// Advance `n` steps, releasing the GIL in chunks of `chunk` steps; Ctrl-C between chunks
+    /// raises SimulationInterrupted with the state consistent at a step boundary.
+    #[pyo3(signature = (n, chunk=2000))]
+    fn step(&mut self, py: Python<'_>, n: u64, chunk: u64) -> PyResult<()> {
+        let chunk = chunk.max(1);
+        let mut done = 0;
+        while done < n {
+            let k = chunk.min(n - done);
+            let sim = &mut self.sim;
+            py.detach(|| sim.step(k)).map_err(PyDemfemError::from)?;
+            done += k;
+            self.interrupt_check(py)?;
+        }
+        Ok(())
+    }
+
+    /// Advance until the simulated time reaches `t_end` (s); returns the steps taken.
+    #[pyo3(signature = (t_end, chunk=2000))]
+    fn run_until(&mut self, py: Python<'_>, t_end: f64, chunk: u64) -> PyResult<u64> {
+        if !t_end.is_finite() {
+            return Err(invalid("t_end", &t_end.to_string(), "finite"));
+        }
+        let remaining = ((t_end - self.sim.time()) / self.sim.dt()).ceil();
+        if remaining <= 0.0 {
+            return Ok(0);
+        }
+        let n = remaining as u64;
+        self.step(py, n, chunk)?;
+        Ok(n)
+    }
+
+    /// Simulated time, s.
+    #[getter]
+    fn time(&self) -> f64 {
+        self.sim.time()
+    }
+    /// Steps taken.
+    #[getter]
+    fn steps(&self) -> u64 {
+        self.sim.steps()
+    }
+    /// Time step, s.
+    #[getter]
+    fn dt(&self) -> f64 {
+        self.sim.dt()
+    }
+    /// Stable time-step limit, s.
+    #[getter]
+    fn stable_dt(&self) -> f64 {
+        self.sim.stable_step().limit
+    }
+    /// What sets the stable limit.
+    #[getter]
+    fn stable_dt_reason(&self) -> String {
+        self.sim.stable_step().reason.clone()
+    }
+    /// Number of particles.
+    fn __len__(&self) -> usize {
+        self.sim.len()
+    }
+    /// Effect names the step runs.
+    #[getter]
+    fn effects(&self) -> Vec<&'static str> {
+        self.sim.effects().names()
+    }
+
+    /// Centres, m, shape (N, 3).
+    fn positions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        array_n3(py, self.sim.positions())
+    }
+    /// Velocities (half step), m/s, shape (N, 3).
+    fn velocities<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        array_n3(py, self.sim.velocities())
+    }
+    /// Angular velocities (half step), rad/s, shape (N, 3).
+    fn angular_velocities<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        array_n3(py, self.sim.angular_velocities())
+    }
+    /// Sum of contact forces per particle at the last step, N, shape (N, 3).
+    fn contact_force_sums<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        array_n3(py, self.sim.contact_force_sums())
+    }
+    /// Radii, m.
+    fn radii<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.sim.radii().to_vec().into_pyarray(py)
+    }
+    /// Masses, kg.
+    fn masses<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.sim.masses().to_vec().into_pyarray(py)
+    }
+    /// Particle–particle coordination number of each particle.
+    fn coordination<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<u32>> {
+        self.sim.coordination().to_vec().into_pyarray(py)
+    }
+    /// Wall contacts of each particle.
+    fn wall_contacts<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<u32>> {
+        self.sim.wall_contact_counts().to_vec().into_pyarray(py)
+    }
+    /// Tags.
+    fn tags<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<u32>> {
+        self.sim.tags().to_vec().into_pyarray(py)
+    }
+    /// Alive flags.
+    fn alive<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
+        self.sim.alive().to_vec().into_pyarray(py)
+    }
+    /// Kinetic energy (translation + rotation), J.
+    fn kinetic_energy(&self) -> f64 {
+        self.sim.kinetic_energy()
+    }
+    /// Largest overlap at the last step, m.
+    fn max_overlap(&self) -> f64 {
+        self.sim.max_overlap()
+    }
+    /// Spheres whose centre is above floor_z + radius + tolerance (m).
+    #[pyo3(signature = (floor_z=0.0, tolerance=0.002))]
+    fn riding_up_count(&self, floor_z: f64, tolerance: f64) -> usize {
+        self.sim.riding_up_count(floor_z, tolerance)
+    }
+    /// Remove particle `i` (it stops moving and interacting).
+    fn remove_particle(&mut self, i: usize) -> CoreResult<()> {
+        Ok(self.sim.remove_particle(i)?)
+    }
+
+    /// Recorded frames as a dict of stacked arrays: time (F,), step (F,), positions,
+    /// velocities, angular_velocities, contact_force_sums (F, N, 3), coordination,
+    /// wall_contacts (F, N).
+    fn frames<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let fr = self.sim.frames();
+        let n = self.sim.len();
+        let d = PyDict::new(py);
+        d.set_item(
+            "time",
+            fr.iter()
+                .map(|f| f.time)
+                .collect::<Vec<_>>()
+                .into_pyarray(py),
+        )?;
+        d.set_item(
+            "step",
+            fr.iter()
+                .map(|f| f.step)
+                .collect::<Vec<_>>()
+                .into_pyarray(py),
+        )?;
+        let stack3 =
+            |get: &dyn Fn(&demfem::dem::Frame) -> &Vec<Vec3>| -> PyResult<Bound<'py, PyAny>> {
+                let mut flat = Vec::with_capacity(fr.len() * n * 3);
+                for f in fr {
+                    flat.extend(flat3(get(f)));
+                }
+                Ok(flat.into_pyarray(py).reshape([fr.len(), n, 3])?.into_any())
+            };
+        d.set_item("positions", stack3(&|f| &f.position)?)?;
+        d.set_item("velocities", stack3(&|f| &f.velocity)?)?;
+        d.set_item("angular_velocities", stack3(&|f| &f.angular_velocity)?)?;
+        d.set_item("contact_force_sums", stack3(&|f| &f.contact_force_sum)?)?;
+        let stack_u =
+            |get: &dyn Fn(&demfem::dem::Frame) -> &Vec<u32>| -> PyResult<Bound<'py, PyAny>> {
+                let mut flat = Vec::with_capacity(fr.len() * n);
+                for f in fr {
+                    flat.extend_from_slice(get(f));
+                }
+                Ok(flat.into_pyarray(py).reshape([fr.len(), n])?.into_any())
+            };
+        d.set_item("coordination", stack_u(&|f| &f.coordination)?)?;
+        d.set_item("wall_contacts", stack_u(&|f| &f.wall_contacts)?)?;
+        Ok(d)
+    }
+
+    /// Every contact onset: time, step, particle, partner, partner_is_wall, normal_speed,
+    /// tangential_speed (m/s), position, partner_position (K, 3) (m).
+    fn onsets<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let o = self.sim.onsets();
+        let d = PyDict::new(py);
+        d.set_item(
+            "time",
+            o.iter()
+                .map(|x| x.time)
+                .collect::<Vec<_>>()
+                .into_pyarray(py),
+        )?;
+        d.set_item(
+            "step",
+            o.iter()
+                .map(|x| x.step)
+                .collect::<Vec<_>>()
+                .into_pyarray(py),
+        )?;
+        d.set_item(
+            "particle",
+            o.iter()
+                .map(|x| x.particle)
+                .collect::<Vec<_>>()
+                .into_pyarray(py),
+        )?;
+        let (partner, is_wall): (Vec<u32>, Vec<bool>) = o
+            .iter()
+            .map(|x| match x.partner {
+                Partner::Particle(j) => (j, false),
+                Partner::Wall(w) => (w, true),
+            })
+            .unzip();
+        d.set_item("partner", partner.into_pyarray(py))?;
+        d.set_item("partner_is_wall", is_wall.into_pyarray(py))?;
+        d.set_item(
+            "normal_speed",
+            o.iter()
+                .map(|x| x.normal_speed)
+                .collect::<Vec<_>>()
+                .into_pyarray(py),
+        )?;
+        d.set_item(
+            "tangential_speed",
+            o.iter()
+                .map(|x| x.tangential_speed)
+                .collect::<Vec<_>>()
+                .into_pyarray(py),
+        )?;
+        d.set_item(
+            "position",
+            array_n3(py, &o.iter().map(|x| x.position).collect::<Vec<_>>())?,
+        )?;
+        d.set_item(
+            "partner_position",
+            array_n3(
+                py,
+                &o.iter().map(|x| x.partner_position).collect::<Vec<_>>(),
+            )?,
+        )?;
+        Ok(d)
+    }
+
+    /// Active contacts: particle, partner, partner_is_wall, normal (K, 3), normal_force (N),
+    /// tangential_force (K, 3) (N), overlap (m), point (K, 3) (m).
+    fn contacts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let c = self.sim.contacts();
+        let d = PyDict::new(py);
+        d.set_item(
+            "particle",
+            c.iter()
+                .map(|x| x.particle)
+                .collect::<Vec<_>>()
+                .into_pyarray(py),
+        )?;
+        let (partner, is_wall): (Vec<u32>, Vec<bool>) = c
+            .iter()
+            .map(|x| match x.partner {
+                Partner::Particle(j) => (j, false),
+                Partner::Wall(w) => (w, true),
+            })
+            .unzip();
+        d.set_item("partner", partner.into_pyarray(py))?;
+        d.set_item("partner_is_wall", is_wall.into_pyarray(py))?;
+        d.set_item(
+            "normal",
+            array_n3(py, &c.iter().map(|x| x.normal).collect::<Vec<_>>())?,
+        )?;
+        d.set_item(
+            "normal_force",
+            c.iter()
+                .map(|x| x.normal_force)
+                .collect::<Vec<_>>()
+                .into_pyarray(py),
+        )?;
+        d.set_item(
+            "tangential_force",
+            array_n3(
+                py,
+                &c.iter().map(|x| x.tangential_force).collect::<Vec<_>>(),
+            )?,
+        )?;
+        d.set_item(
+            "overlap",
+            c.iter()
+                .map(|x| x.overlap)
+                .collect::<Vec<_>>()
+                .into_pyarray(py),
+        )?;
+        d.set_item(
+            "point",
+            array_n3(py, &c.iter().map(|x| x.point).collect::<Vec<_>>())?,
+        )?;
+        Ok(d)
+    }
+
+    /// Drop recorded frames and onsets.
+    fn clear_records(&mut self) {
+        self.sim.clear_records();
+    }
+
+    /// Write a checkpoint atomically to `path`.
+    fn save_checkpoint(&self, py: Python<'_>, path: PathBuf) -> CoreResult<()> {
+        let sim = &self.sim;
+        Ok(py.detach(|| sim.save_checkpoint(&path))?)
+    }
+
+    /// Restore a checkpoint written by a simulation built from the same scene.
+    fn load_checkpoint(&mut self, py: Python<'_>, path: PathBuf) -> CoreResult<()> {
+        let sim = &mut self.sim;
+        Ok(py.detach(|| sim.load_checkpoint(&path))?)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "DemSimulation(n={}, t={} s, steps={}, dt={:e} s, effects={:?})",
+            self.sim.len(),
+            self.sim.time(),
+            self.sim.steps(),
+            self.sim.dt(),
+            self.sim.effects().names()
+        )
+    }
+}
+
+impl DemSimulation {
+    fn interrupt_check(&self, py: Python<'_>) -> PyResult<()> {
+        if let Err(e) = py.check_signals() {
+            if e.is_instance_of::<pyo3::exceptions::PyKeyboardInterrupt>(py) {
+                return Err(PyDemfemError::from(DemfemError::Interrupted {
+                    time: self.sim.time(),
+                    steps: self.sim.steps(),
+                })
+                .into());
+            }
+            return Err(e);
+        }
+        Ok(())
+    }
+}
+
+/// Register the DEM classes on the extension module.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<DemSimulation>()?;
+    Ok(())
+}

@@ -1,0 +1,1460 @@
+//! The DEM simulation: state as structure of arrays, the two-phase step and its contact
+//! kernels.
+//!
+//! One step (leapfrog, velocities stored at half steps):
+//! 1. rebuild the Verlet lists if a particle or a wall moved more than half the skin;
+//! 2. **pair phase** — for every candidate pair, in parallel chunks, the contact force from
+//!    x(t) and v(t − Δt/2) is written into the pair's own slot (no shared accumulator);
+//! 3. **particle phase** — for every particle, in parallel chunks: the pair forces are gathered
+//!    in the fixed order of the particle's pair list, the particle's own wall contacts are
+//!    computed, and the particle is advanced: v += F/m Δt, x += v Δt, ω += T/I Δt.
+//!
+//! Every floating-point sum is taken in an order fixed by the lists, never by the thread
+//! schedule, so results are bitwise identical for any thread count; the step synchronises
+//! twice. Systems below [`PARALLEL_MIN_PARTICLES`] run serially.
+
+use rayon::prelude::*;
+
+use crate::contact::{self, ForceClamp};
+use crate::dem::effects::{Effect, EffectSet};
+use crate::dem::material::{ContactModel, PairLaw};
+use crate::dem::neighbor::CellGrid;
+use crate::dem::record::{ContactOnset, ContactRecord, Frame, Partner};
+use crate::dem::scene::Scene;
+use crate::error::{DemfemError, Result};
+use crate::geometry::{Vec3, Wall};
+
+/// Below this many particles the step runs on the calling thread whatever `threads` says:
+/// a rayon fork-join costs microseconds, as much as the whole step of a small system.
+pub const PARALLEL_MIN_PARTICLES: usize = 256;
+const PAIR_CHUNK: usize = 256;
+const PARTICLE_CHUNK: usize = 64;
+const NO_WALL: u32 = u32::MAX;
+
+/// A candidate particle pair of the Verlet list with its contact state. `repr(C)` with the
+/// fields the gather reads (force, torque, overlap) in the first 64-byte cache line: the
+/// gather visits pairs in particle order, not memory order.
+#[derive(Debug, Clone, Copy, Default)]
+#[repr(C)]
+pub(crate) struct PairContact {
+    /// Force on particle i, N.
+    pub(crate) force: Vec3,
+    /// n × F_t: the torque on i (and on j) per unit lever arm, N.
+    pub(crate) torque_per_arm: Vec3,
+    /// Overlap δ, m; > 0 exactly when the pair is in contact (the gather's activity test).
+    pub(crate) overlap: f64,
+    pub(crate) i: u32,
+    pub(crate) j: u32,
+    /// Rolling-resistance torque on i (−this on j), N·m.
+    pub(crate) rolling_torque: Vec3,
+    /// Tangential spring displacement ξ, m (Mindlin history).
+    pub(crate) history: Vec3,
+    /// Unit normal from i to j.
+    pub(crate) normal: Vec3,
+    pub(crate) normal_force: f64,
+    pub(crate) onset_normal_speed: f64,
+    pub(crate) onset_tangential_speed: f64,
+    /// In contact at the last force evaluation.
+    pub(crate) active: bool,
+    /// The contact began at the last force evaluation.
+    pub(crate) onset: bool,
+}
+
+/// What the gather needs of a pair, written by the pair phase every step: one 64-byte line
+/// per pair, so the gather (which visits pairs in particle order, not memory order) touches
+/// one cache line per contact.
+#[derive(Debug, Clone, Copy, Default)]
+#[repr(C, align(64))]
+pub(crate) struct PairOut {
+    force: Vec3,
+    torque_per_arm: Vec3,
+    /// > 0 exactly when the pair is in contact.
+    overlap: f64,
+}
+
+/// A candidate particle–wall contact slot.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct WallContact {
+    pub(crate) wall: u32,
+    pub(crate) active: bool,
+    pub(crate) onset: bool,
+    pub(crate) history: Vec3,
+    pub(crate) force: Vec3,
+    pub(crate) normal: Vec3,
+    pub(crate) point: Vec3,
+    pub(crate) overlap: f64,
+    pub(crate) normal_force: f64,
+    pub(crate) onset_normal_speed: f64,
+    pub(crate) onset_tangential_speed: f64,
+}
+
+impl Default for WallContact {
+    fn default() -> Self {
+        WallContact {
+            wall: NO_WALL,
+            active: false,
+            onset: false,
+            history: Vec3::ZERO,
+            force: Vec3::ZERO,
+            normal: Vec3::ZERO,
+            point: Vec3::ZERO,
+            overlap: 0.0,
+            normal_force: 0.0,
+            onset_normal_speed: 0.0,
+            onset_tangential_speed: 0.0,
+        }
+    }
+}
+
+/// Current position offset and velocity of each wall.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct WallState {
+    offset: Vec3,
+    velocity: Vec3,
+}
+
+/// The stable time step of a scene and what sets it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StableStep {
+    /// Largest accepted step, s.
+    pub limit: f64,
+    /// Which law or criterion sets it.
+    pub reason: String,
+}
+
+/// A running DEM simulation.
+pub struct Simulation {
+    // ---- static data
+    pub(crate) radius: Vec<f64>,
+    pub(crate) mass: Vec<f64>,
+    pub(crate) inv_mass: Vec<f64>,
+    pub(crate) inertia: Vec<f64>,
+    pub(crate) inv_inertia: Vec<f64>,
+    pub(crate) material: Vec<u32>,
+    pub(crate) tag: Vec<u32>,
+    pub(crate) walls: Vec<Wall>,
+    pub(crate) laws: Vec<PairLaw>,
+    pub(crate) n_materials: usize,
+    pub(crate) model: ContactModel,
+    pub(crate) effects: EffectSet,
+    pub(crate) gravity: Vec3,
+    pub(crate) clamp: bool,
+    pub(crate) dt: f64,
+    pub(crate) stable: StableStep,
+    pub(crate) skin: f64,
+    pub(crate) threads: usize,
+    pub(crate) record_every: u64,
+    pub(crate) record_onsets: bool,
+    /// Outlet plane (point, unit normal towards the kept side).
+    pub(crate) removal_plane: Option<(Vec3, Vec3)>,
+    // ---- dynamic state (what a checkpoint holds)
+    pub(crate) position: Vec<Vec3>,
+    pub(crate) velocity: Vec<Vec3>,
+    pub(crate) omega: Vec<Vec3>,
+    pub(crate) alive: Vec<bool>,
+    pub(crate) time: f64,
+    pub(crate) steps: u64,
+    pub(crate) pairs: Vec<PairContact>,
+    pair_out: Vec<PairOut>,
+    pub(crate) wall_slots: Vec<WallContact>,
+    pub(crate) wall_stride: usize,
+    pub(crate) reference_position: Vec<Vec3>,
+    pub(crate) reference_wall_offset: Vec<Vec3>,
+    pub(crate) needs_rebuild: bool,
+    // ---- derived, rebuilt from the state
+    pub(crate) csr_offset: Vec<u32>,
+    pub(crate) csr_entry: Vec<u32>,
+    grid: CellGrid,
+    candidate_scratch: Vec<(u32, u32)>,
+    old_pairs: Vec<PairContact>,
+    old_slots: Vec<WallContact>,
+    wall_state: Vec<WallState>,
+    chunk_onsets: Vec<u32>,
+    chunk_results: Vec<(f64, bool, u32)>,
+    pub(crate) contact_force_sum: Vec<Vec3>,
+    pub(crate) coordination: Vec<u32>,
+    pub(crate) wall_coordination: Vec<u32>,
+    pool: Option<rayon::ThreadPool>,
+    // ---- records
+    pub(crate) frames: Vec<Frame>,
+    pub(crate) onsets: Vec<ContactOnset>,
+    pub(crate) rebuilds: u64,
+    /// (time, particle) of every removal through the outlet plane.
+    pub(crate) removals: Vec<(f64, u32)>,
+}
+
+impl std::fmt::Debug for Simulation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Simulation")
+            .field("particles", &self.position.len())
+            .field("walls", &self.walls.len())
+            .field("time", &self.time)
+            .field("steps", &self.steps)
+            .field("dt", &self.dt)
+            .field("effects", &self.effects.names())
+            .finish()
+    }
+}
+
+/// Read-only context of the pair kernel.
+struct PairCtx<'a> {
+    position: &'a [Vec3],
+    velocity: &'a [Vec3],
+    omega: &'a [Vec3],
+    radius: &'a [f64],
+    mass: &'a [f64],
+    inertia: &'a [f64],
+    material: &'a [u32],
+    laws: &'a [PairLaw],
+    n_materials: usize,
+    model: ContactModel,
+    effects: EffectSet,
+    clamp: bool,
+    dt: f64,
+}
+
+/// Read-only context of the particle phase.
+struct ParticleCtx<'a> {
+    pairs: &'a [PairContact],
+    pair_out: &'a [PairOut],
+    csr_offset: &'a [u32],
+    csr_entry: &'a [u32],
+    radius: &'a [f64],
+    mass: &'a [f64],
+    inv_mass: &'a [f64],
+    inertia: &'a [f64],
+    inv_inertia: &'a [f64],
+    material: &'a [u32],
+    alive: &'a [bool],
+    reference_position: &'a [Vec3],
+    walls: &'a [Wall],
+    wall_state: &'a [WallState],
+    laws: &'a [PairLaw],
+    n_materials: usize,
+    model: ContactModel,
+    effects: EffectSet,
+    gravity: Vec3,
+    clamp: bool,
+    dt: f64,
+    wall_stride: usize,
+}
+
+/// Normal and tangential law of one contact: elastic force, tangent stiffness, damping
+/// coefficient and tangential stiffness.
+#[inline(always)]
+fn contact_law(
+    model: ContactModel,
+    law: &PairLaw,
+    effects: EffectSet,
+    overlap: f64,
+    r_star: f64,
+    m_star: f64,
+) -> (f64, f64, f64, f64) {
+    let (f_el, k_n, k_t) = match model {
+        ContactModel::HertzMindlin => {
+            let a = (r_star * overlap).sqrt(); // contact radius
+            (
+                4.0 / 3.0 * law.e_star * a * overlap,
+                2.0 * law.e_star * a,
+                8.0 * law.g_star * a,
+            )
+        }
+        ContactModel::HertzReissnerMindlin => {
+            let k_h = 4.0 / 3.0 * law.e_star * r_star.sqrt();
+            if law.shell_stiffness.is_infinite() {
+                let a = (r_star * overlap).sqrt();
+                (
+                    4.0 / 3.0 * law.e_star * a * overlap,
+                    2.0 * law.e_star * a,
+                    8.0 * law.g_star * a,
+                )
+            } else {
+                let (f, k) = contact::NormalLaw::HertzReissner {
+                    k_h,
+                    k_r: law.shell_stiffness,
+                }
+                .force_and_stiffness(overlap);
+                // Mindlin spring on the Hertz indentation δ_H = (F/k_H)^{2/3} only
+                let delta_h = (f / k_h).powf(2.0 / 3.0);
+                (f, k, 8.0 * law.g_star * (r_star * delta_h).sqrt())
+            }
+        }
+        ContactModel::LinearSpringDashpot {
+            normal_stiffness,
+            tangential_stiffness,
+        } => (
+            normal_stiffness * overlap,
+            normal_stiffness,
+            tangential_stiffness,
+        ),
+    };
+    let c_n = if effects.has(Effect::Damping) {
+        match model {
+            ContactModel::LinearSpringDashpot { .. } => law.linear_damping * (m_star * k_n).sqrt(),
+            _ => law.zeta * (2.0 / 3.0 * m_star * k_n).sqrt(),
+        }
+    } else {
+        0.0
+    };
+    (f_el, c_n, k_t, k_n)
+}
+
+/// Tangential force with Mindlin history, rotated onto the current tangent plane, and the
+/// Coulomb cap. Returns the force on the first body and updates `history`.
+#[inline(always)]
+fn tangential_force(
+    history: &mut Vec3,
+    normal: Vec3,
+    v_t: Vec3,
+    k_t: f64,
+    c_t: f64,
+    cap: f64,
+    dt: f64,
+) -> Vec3 {
+    // follow the contact plane: drop the spring's normal part. The length lost per step is
+    // (Ω Δt)²/2 of it for a contact turning at rate Ω, negligible over a contact's life, and
+    // saves a square root and a division per contact and step.
+    let mut xi = *history;
+    xi -= xi.dot(normal) * normal;
+    xi += v_t * dt;
+    let mut f_t = -k_t * xi - c_t * v_t;
+    let f2 = f_t.length_squared();
+    if f2 > cap * cap {
+        // gross sliding: the force sits on the cone; the spring carries it all
+        f_t *= cap / f2.sqrt();
+        xi = if k_t > 0.0 {
+            f_t * (-1.0 / k_t)
+        } else {
+            Vec3::ZERO
+        };
+    }
+    *history = xi;
+    f_t
+}
+
+/// Force of one candidate pair; returns whether a contact began.
+#[inline(always)]
+fn pair_kernel(p: &mut PairContact, out: &mut PairOut, c: &PairCtx<'_>) -> bool {
+    let i = p.i as usize;
+    let j = p.j as usize;
+    let d = c.position[j] - c.position[i];
+    let dist2 = d.length_squared();
+    let r_sum = c.radius[i] + c.radius[j];
+    if dist2 >= r_sum * r_sum || dist2 == 0.0 {
+        if p.active {
+            p.active = false;
+            p.history = Vec3::ZERO;
+            p.force = Vec3::ZERO;
+            p.torque_per_arm = Vec3::ZERO;
+            p.rolling_torque = Vec3::ZERO;
+            p.overlap = 0.0;
+            p.normal_force = 0.0;
+        }
+        out.overlap = 0.0;
+        p.onset = false;
+        return false;
+    }
+    let dist = dist2.sqrt();
+    // rounding can give dist = r_sum for dist² just below r_sum²; keep the overlap positive,
+    // the gather's activity test
+    let overlap = (r_sum - dist).max(f64::MIN_POSITIVE);
+    let n = d * (1.0 / dist); // one division instead of three
+    let rotation = c.effects.has(Effect::Rotation);
+    let arm_i = c.radius[i] - 0.5 * overlap;
+    let arm_j = c.radius[j] - 0.5 * overlap;
+    let mut v_rel = c.velocity[i] - c.velocity[j];
+    if rotation {
+        v_rel += (arm_i * c.omega[i] + arm_j * c.omega[j]).cross(n);
+    }
+    let v_n = v_rel.dot(n); // > 0 approaching
+    let onset = !p.active;
+    p.active = true;
+    p.onset = onset;
+    let v_t = v_rel - v_n * n;
+    if onset {
+        p.onset_normal_speed = v_n;
+        p.onset_tangential_speed = v_t.length();
+    }
+    let law = &c.laws[c.material[i] as usize * c.n_materials + c.material[j] as usize];
+    let m_star = c.mass[i] * c.mass[j] / (c.mass[i] + c.mass[j]);
+    let r_star = c.radius[i] * c.radius[j] / r_sum;
+    let (f_el, c_n, k_t, _) = contact_law(c.model, law, c.effects, overlap, r_star, m_star);
+    let mut f_n = f_el + c_n * v_n;
+    if c.clamp && f_n < 0.0 {
+        f_n = 0.0;
+    }
+    let mut force = -f_n * n;
+    if c.effects.has(Effect::Friction) {
+        let f_t = tangential_force(
+            &mut p.history,
+            n,
+            v_t,
+            k_t,
+            c_n * law.tangential_damping_ratio,
+            law.friction * f_n.max(0.0),
+            c.dt,
+        );
+        force += f_t;
+        p.torque_per_arm = if rotation { n.cross(f_t) } else { Vec3::ZERO };
+    }
+    if c.effects.has(Effect::RollingResistance) {
+        let w_rel = c.omega[i] - c.omega[j];
+        let w_roll = w_rel - w_rel.dot(n) * n;
+        let w_mag = w_roll.length();
+        if w_mag > 0.0 {
+            let i_star = c.inertia[i] * c.inertia[j] / (c.inertia[i] + c.inertia[j]);
+            // constant torque, but never more than what stops the relative rolling in one step
+            let m = (law.rolling_friction * r_star * f_n.max(0.0)).min(i_star * w_mag / c.dt);
+            p.rolling_torque = -m / w_mag * w_roll;
+        } else {
+            p.rolling_torque = Vec3::ZERO;
+        }
+    }
+    p.force = force;
+    p.normal = n;
+    p.overlap = overlap;
+    p.normal_force = f_n;
+    *out = PairOut {
+        force,
+        torque_per_arm: p.torque_per_arm,
+        overlap,
+    };
+    onset
+}
+
+/// Force of one particle–wall slot on particle i; returns (force, torque) and flags onset.
+#[inline(always)]
+fn wall_kernel(
+    s: &mut WallContact,
+    i: usize,
+    x: Vec3,
+    v: Vec3,
+    w: Vec3,
+    c: &ParticleCtx<'_>,
+) -> (Vec3, Vec3) {
+    let wall = &c.walls[s.wall as usize];
+    let ws = c.wall_state[s.wall as usize];
+    let r = c.radius[i];
+    let hit = wall.closest_at(x, ws.offset);
+    let (point, out_normal, dist) = match hit {
+        Some(h) if h.2 < r => h,
+        _ => {
+            if s.active {
+                s.active = false;
+                s.history = Vec3::ZERO;
+                s.force = Vec3::ZERO;
+                s.overlap = 0.0;
+                s.normal_force = 0.0;
+            }
+            s.onset = false;
+            return (Vec3::ZERO, Vec3::ZERO);
+        }
+    };
+    let n = -out_normal; // from the particle towards the wall
+    let overlap = r - dist;
+    let rotation = c.effects.has(Effect::Rotation);
+    let arm = dist.max(0.0);
+    let mut wall_v = ws.velocity;
+    if c.effects.has(Effect::Belt) {
+        let s_v = wall.surface_velocity;
+        wall_v += s_v - s_v.dot(n) * n;
+    }
+    let mut v_rel = v - wall_v;
+    if rotation {
+        v_rel += (arm * w).cross(n);
+    }
+    let v_n = v_rel.dot(n);
+    let onset = !s.active;
+    s.active = true;
+    s.onset = onset;
+    let v_t = v_rel - v_n * n;
+    if onset {
+        s.onset_normal_speed = v_n;
+        s.onset_tangential_speed = v_t.length();
+    }
+    let law = &c.laws[c.material[i] as usize * c.n_materials + wall.material];
+    let m_star = c.mass[i];
+    let (f_el, c_n, k_t, _) = contact_law(c.model, law, c.effects, overlap, r, m_star);
+    let mut f_n = f_el + c_n * v_n;
+    if c.clamp && f_n < 0.0 {
+        f_n = 0.0;
+    }
+    let mut force = -f_n * n;
+    let mut torque = Vec3::ZERO;
+    if c.effects.has(Effect::Friction) {
+        let f_t = tangential_force(
+            &mut s.history,
+            n,
+            v_t,
+            k_t,
+            c_n * law.tangential_damping_ratio,
+            law.friction * f_n.max(0.0),
+            c.dt,
+        );
+        force += f_t;
+        if rotation {
+            torque = arm * n.cross(f_t);
+        }
+    }
+    if c.effects.has(Effect::RollingResistance) {
+        let w_roll = w - w.dot(n) * n;
+        let w_mag = w_roll.length();
+        if w_mag > 0.0 {
+            let m = (law.rolling_friction * r * f_n.max(0.0)).min(c.inertia[i] * w_mag / c.dt);
+            torque -= m / w_mag * w_roll;
+        }
+    }
+    s.force = force;
+    s.normal = n;
+    s.point = point;
+    s.overlap = overlap;
+    s.normal_force = f_n;
+    (force, torque)
+}
+
+/// Particle phase on one chunk of particles starting at `first`. Returns (largest squared
+/// displacement since the last rebuild, any non-finite value, wall onsets).
+#[allow(clippy::too_many_arguments)]
+fn particle_chunk(
+    c: &ParticleCtx<'_>,
+    first: usize,
+    position: &mut [Vec3],
+    velocity: &mut [Vec3],
+    omega: &mut [Vec3],
+    force_sum: &mut [Vec3],
+    coordination: &mut [u32],
+    wall_coordination: &mut [u32],
+    slots: &mut [WallContact],
+) -> (f64, bool, u32) {
+    let rotation = c.effects.has(Effect::Rotation);
+    let rolling = c.effects.has(Effect::RollingResistance);
+    let planar = c.effects.has(Effect::Planar);
+    let gravity = if c.effects.has(Effect::Gravity) {
+        c.gravity
+    } else {
+        Vec3::ZERO
+    };
+    let mut max_disp2: f64 = 0.0;
+    // 0 × finite = 0 while 0 × (inf or NaN) = NaN: one multiply-add per particle instead of
+    // nine finiteness tests, checked once per chunk
+    let mut probe = Vec3::ZERO;
+    let mut wall_onsets = 0u32;
+    for k in 0..position.len() {
+        let i = first + k;
+        if !c.alive[i] {
+            continue;
+        }
+        let mut f = Vec3::ZERO;
+        let mut t = Vec3::ZERO;
+        let mut z = 0u32;
+        let (a, b) = (c.csr_offset[i] as usize, c.csr_offset[i + 1] as usize);
+        for &e in &c.csr_entry[a..b] {
+            let p = &c.pair_out[(e >> 1) as usize];
+            if !(p.overlap > 0.0) {
+                continue;
+            }
+            z += 1;
+            let arm = c.radius[i] - 0.5 * p.overlap;
+            if e & 1 == 0 {
+                f += p.force;
+            } else {
+                f -= p.force;
+            }
+            if rotation {
+                t += arm * p.torque_per_arm;
+                if rolling {
+                    let m = c.pairs[(e >> 1) as usize].rolling_torque;
+                    t += if e & 1 == 0 { m } else { -m };
+                }
+            }
+        }
+        if planar {
+            // upright cartridges cannot climb on each other: particle forces act in the plane
+            f.z = 0.0;
+        }
+        let (x, v, w) = (position[k], velocity[k], omega[k]);
+        let mut zw = 0u32;
+        let stride = c.wall_stride;
+        for s in &mut slots[k * stride..(k + 1) * stride] {
+            if s.wall == NO_WALL {
+                break;
+            }
+            let (fw, tw) = wall_kernel(s, i, x, v, w, c);
+            if s.active {
+                zw += 1;
+                if s.onset {
+                    wall_onsets += 1;
+                }
+                f += fw;
+                t += tw;
+            }
+        }
+        force_sum[k] = f;
+        coordination[k] = z;
+        wall_coordination[k] = zw;
+        let v_new = v + (f * c.inv_mass[i] + gravity) * c.dt;
+        let x_new = x + v_new * c.dt;
+        velocity[k] = v_new;
+        position[k] = x_new;
+        if rotation {
+            let mut w_new = w + t * (c.inv_inertia[i] * c.dt);
+            if planar {
+                w_new.x = 0.0;
+                w_new.y = 0.0;
+            }
+            omega[k] = w_new;
+            probe += w_new * 0.0;
+        }
+        probe += (x_new + v_new) * 0.0;
+        max_disp2 = max_disp2.max((x_new - c.reference_position[i]).length_squared());
+    }
+    (max_disp2, !probe.is_finite(), wall_onsets)
+}
+
+impl Simulation {
+    /// Build a simulation from a scene: validate it, derive masses, pair laws and the time
+    /// step, build the neighbour lists and refuse initial overlaps beyond the tolerance.
+    pub fn new(scene: &Scene) -> Result<Self> {
+        scene.validate()?;
+        let p = &scene.particles;
+        let n = p.len();
+        let mut mass = Vec::with_capacity(n);
+        let mut inertia = Vec::with_capacity(n);
+        for i in 0..n {
+            let r = p.radius[i];
+            let m = scene.materials[p.material[i]].density * 4.0 / 3.0
+                * std::f64::consts::PI
+                * r
+                * r
+                * r;
+            mass.push(m);
+            inertia.push(0.4 * m * r * r);
+        }
+        let n_materials = scene.materials.len();
+        let clamp = if scene.clamp_normal_force {
+            ForceClamp::NonNegative
+        } else {
+            ForceClamp::None
+        };
+        let mut laws = Vec::with_capacity(n_materials * n_materials);
+        // ζ from restitution costs a bisection over an ODE solve: once per distinct e
+        let mut zeta_cache: Vec<(u64, f64)> = Vec::new();
+        for a in 0..n_materials {
+            for b in 0..n_materials {
+                let (ma, mb) = (&scene.materials[a], &scene.materials[b]);
+                let e = ma.restitution.min(mb.restitution);
+                let zeta = if !scene.model.is_hertzian() {
+                    0.0
+                } else if let Some((_, z)) = zeta_cache.iter().find(|(k, _)| *k == e.to_bits()) {
+                    *z
+                } else {
+                    let z = contact::tsuji_damping_for_restitution(e, clamp)?;
+                    zeta_cache.push((e.to_bits(), z));
+                    z
+                };
+                laws.push(PairLaw::with_zeta(ma, mb, scene.model, zeta)?);
+            }
+        }
+        let stable = stable_time_step(scene, &mass)?;
+        let dt = match scene.time_step {
+            Some(dt) => {
+                if dt > stable.limit {
+                    return Err(DemfemError::UnstableTimeStep {
+                        dt,
+                        limit: stable.limit,
+                        reason: stable.reason.clone(),
+                    });
+                }
+                dt
+            }
+            None => scene.time_step_safety * stable.limit,
+        };
+        let d_max = p.radius.iter().fold(0.0_f64, |a, &r| a.max(2.0 * r));
+        let skin = scene.skin.unwrap_or(0.1 * d_max.max(f64::MIN_POSITIVE));
+        let pool = if scene.threads > 1 {
+            Some(
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(scene.threads)
+                    .build()
+                    .map_err(|e| {
+                        DemfemError::Numerical(format!(
+                            "cannot start {} threads: {e}",
+                            scene.threads
+                        ))
+                    })?,
+            )
+        } else {
+            None
+        };
+        let mut sim = Simulation {
+            radius: p.radius.clone(),
+            inv_mass: mass.iter().map(|m| 1.0 / m).collect(),
+            inv_inertia: inertia.iter().map(|m| 1.0 / m).collect(),
+            mass,
+            inertia,
+            material: p.material.iter().map(|&m| m as u32).collect(),
+            tag: p.tag.clone(),
+            walls: scene.walls.clone(),
+            laws,
+            n_materials,
+            model: scene.model,
+            effects: scene.effects,
+            gravity: scene.gravity,
+            clamp: scene.clamp_normal_force,
+            dt,
+            stable,
+            skin,
+            threads: scene.threads,
+            record_every: scene.record_every,
+            record_onsets: scene.record_onsets,
+            removal_plane: scene.removal_plane.map(|(p, n)| (p, n / n.length())),
+            position: p.position.clone(),
+            velocity: p.velocity.clone(),
+            omega: p.angular_velocity.clone(),
+            alive: vec![true; n],
+            time: 0.0,
+            steps: 0,
+            pairs: Vec::new(),
+            pair_out: Vec::new(),
+            wall_slots: Vec::new(),
+            wall_stride: 1,
+            reference_position: p.position.clone(),
+            reference_wall_offset: vec![Vec3::ZERO; scene.walls.len()],
+            needs_rebuild: true,
+            csr_offset: vec![0; n + 1],
+            csr_entry: Vec::new(),
+            grid: CellGrid::default(),
+            candidate_scratch: Vec::new(),
+            old_pairs: Vec::new(),
+            old_slots: Vec::new(),
+            wall_state: vec![WallState::default(); scene.walls.len()],
+            chunk_onsets: Vec::new(),
+            chunk_results: Vec::new(),
+            contact_force_sum: vec![Vec3::ZERO; n],
+            coordination: vec![0; n],
+            wall_coordination: vec![0; n],
+            pool,
+            frames: Vec::new(),
+            onsets: Vec::new(),
+            rebuilds: 0,
+            removals: Vec::new(),
+        };
+        sim.refresh_wall_state();
+        sim.rebuild();
+        sim.check_initial_overlaps(scene.initial_overlap_tolerance)?;
+        Ok(sim)
+    }
+
+    fn check_initial_overlaps(&self, tolerance: f64) -> Result<()> {
+        for p in &self.pairs {
+            let (i, j) = (p.i as usize, p.j as usize);
+            let overlap =
+                self.radius[i] + self.radius[j] - (self.position[j] - self.position[i]).length();
+            if overlap > tolerance * self.radius[i].min(self.radius[j]) {
+                return Err(DemfemError::InvalidParameter {
+                    field: format!("particles {i} and {j}"),
+                    value: format!("initial overlap {overlap:e} m"),
+                    allowed: format!("overlap <= {tolerance} x the smaller radius"),
+                });
+            }
+        }
+        for i in 0..self.position.len() {
+            for s in &self.wall_slots[i * self.wall_stride..(i + 1) * self.wall_stride] {
+                if s.wall == NO_WALL {
+                    break;
+                }
+                let ws = self.wall_state[s.wall as usize];
+                if let Some((_, _, d)) =
+                    self.walls[s.wall as usize].closest_at(self.position[i], ws.offset)
+                {
+                    let overlap = self.radius[i] - d;
+                    if overlap > tolerance * self.radius[i] {
+                        return Err(DemfemError::InvalidParameter {
+                            field: format!("particle {i} and wall {}", s.wall),
+                            value: format!("initial overlap {overlap:e} m"),
+                            allowed: format!("overlap <= {tolerance} x the radius"),
+                        });
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    pub(crate) fn refresh_wall_state(&mut self) {
+        let moving = self.effects.has(Effect::MovingWalls);
+        for (k, w) in self.walls.iter().enumerate() {
+            let (offset, velocity) = if moving {
+                w.motion.offset_and_velocity(self.time)
+            } else {
+                (Vec3::ZERO, Vec3::ZERO)
+            };
+            self.wall_state[k] = WallState { offset, velocity };
+        }
+    }
+
+    /// Gather lists (CSR): the pair indices of each particle in increasing order, tagged
+    /// with the side (bit 0: particle is j). A pure function of the pair list.
+    pub(crate) fn build_gather_lists(&mut self) {
+        let n = self.position.len();
+        self.pair_out.clear();
+        self.pair_out.resize(self.pairs.len(), PairOut::default());
+        self.csr_offset.clear();
+        self.csr_offset.resize(n + 1, 0);
+        for p in &self.pairs {
+            self.csr_offset[p.i as usize + 1] += 1;
+            self.csr_offset[p.j as usize + 1] += 1;
+        }
+        for i in 0..n {
+            self.csr_offset[i + 1] += self.csr_offset[i];
+        }
+        self.csr_entry.clear();
+        self.csr_entry.resize(self.csr_offset[n] as usize, 0);
+        let mut fill: Vec<u32> = self.csr_offset[..n].to_vec();
+        for (k, p) in self.pairs.iter().enumerate() {
+            let e = (k as u32) << 1;
+            self.csr_entry[fill[p.i as usize] as usize] = e;
+            fill[p.i as usize] += 1;
+            self.csr_entry[fill[p.j as usize] as usize] = e | 1;
+            fill[p.j as usize] += 1;
+        }
+    }
+
+    /// Rebuild the Verlet lists (pairs, wall slots, gather lists), carrying contact history over.
+    pub(crate) fn rebuild(&mut self) {
+        let n = self.position.len();
+        self.rebuilds += 1;
+        if let Some((point, normal)) = self.removal_plane {
+            for i in 0..n {
+                if self.alive[i] && normal.dot(self.position[i] - point) < 0.0 {
+                    self.alive[i] = false;
+                    self.removals.push((self.time, i as u32));
+                }
+            }
+        }
+        // ---- particle pairs
+        self.grid.candidate_pairs(
+            &self.position,
+            &self.radius,
+            &self.alive,
+            self.skin,
+            &mut self.candidate_scratch,
+        );
+        std::mem::swap(&mut self.pairs, &mut self.old_pairs);
+        self.pairs.clear();
+        let mut old = 0usize;
+        for &(i, j) in &self.candidate_scratch {
+            // both lists are sorted by (i, j): merge to carry the state of surviving pairs
+            while old < self.old_pairs.len()
+                && (self.old_pairs[old].i, self.old_pairs[old].j) < (i, j)
+            {
+                old += 1;
+            }
+            if old < self.old_pairs.len()
+                && (self.old_pairs[old].i, self.old_pairs[old].j) == (i, j)
+            {
+                self.pairs.push(self.old_pairs[old]);
+            } else {
+                self.pairs.push(PairContact {
+                    i,
+                    j,
+                    ..Default::default()
+                });
+            }
+        }
+        self.build_gather_lists();
+        // ---- wall slots: walls within reach of each particle (the others are skipped)
+        std::mem::swap(&mut self.wall_slots, &mut self.old_slots);
+        let old_stride = self.wall_stride;
+        let mut counts = vec![0usize; n];
+        let mut stride = 1usize;
+        for i in 0..n {
+            if !self.alive[i] {
+                continue;
+            }
+            let reach = self.radius[i] + self.skin;
+            for (w, wall) in self.walls.iter().enumerate() {
+                if let Some((_, _, d)) =
+                    wall.closest_at(self.position[i], self.wall_state[w].offset)
+                {
+                    if d < reach {
+                        counts[i] += 1;
+                    }
+                }
+            }
+            stride = stride.max(counts[i]);
+        }
+        self.wall_stride = stride;
+        self.wall_slots.clear();
+        self.wall_slots.resize(n * stride, WallContact::default());
+        for i in 0..n {
+            if counts[i] == 0 {
+                continue;
+            }
+            let reach = self.radius[i] + self.skin;
+            let mut k = 0;
+            for (w, wall) in self.walls.iter().enumerate() {
+                if let Some((_, _, d)) =
+                    wall.closest_at(self.position[i], self.wall_state[w].offset)
+                {
+                    if d < reach {
+                        let carried = self
+                            .old_slots
+                            .get(i * old_stride..(i + 1) * old_stride)
+                            .and_then(|s| s.iter().find(|s| s.wall == w as u32).copied());
+                        self.wall_slots[i * stride + k] = carried.unwrap_or(WallContact {
+                            wall: w as u32,
+                            ..Default::default()
+                        });
+                        k += 1;
+                    }
+                }
+            }
+        }
+        self.reference_position.clone_from(&self.position);
+        for (k, ws) in self.wall_state.iter().enumerate() {
+            self.reference_wall_offset[k] = ws.offset;
+        }
+        self.needs_rebuild = false;
+    }
+
+    /// Advance `n` steps.
+    pub fn step(&mut self, n: u64) -> Result<()> {
+        match self.pool.take() {
+            Some(pool) if self.position.len() >= PARALLEL_MIN_PARTICLES => {
+                let r = pool.install(|| {
+                    for _ in 0..n {
+                        self.one_step(true)?;
+                    }
+                    Ok(())
+                });
+                self.pool = Some(pool);
+                r
+            }
+            other => {
+                self.pool = other;
+                for _ in 0..n {
+                    self.one_step(false)?;
+                }
+                Ok(())
+            }
+        }
+    }
+
+    /// Advance until the simulated time reaches `t_end` (s); returns the steps taken.
+    pub fn run_until(&mut self, t_end: f64) -> Result<u64> {
+        if !t_end.is_finite() {
+            return Err(DemfemError::invalid("t_end", t_end, "finite"));
+        }
+        let remaining = ((t_end - self.time) / self.dt).ceil();
+        if remaining <= 0.0 {
+            return Ok(0);
+        }
+        let n = remaining as u64;
+        self.step(n)?;
+        Ok(n)
+    }
+
+    fn one_step(&mut self, parallel: bool) -> Result<()> {
+        if self.needs_rebuild {
+            self.rebuild();
+        }
+        // ---- pair phase
+        {
+            let ctx = PairCtx {
+                position: &self.position,
+                velocity: &self.velocity,
+                omega: &self.omega,
+                radius: &self.radius,
+                mass: &self.mass,
+                inertia: &self.inertia,
+                material: &self.material,
+                laws: &self.laws,
+                n_materials: self.n_materials,
+                model: self.model,
+                effects: self.effects,
+                clamp: self.clamp,
+                dt: self.dt,
+            };
+            let kernel = |(chunk, out): (&mut [PairContact], &mut [PairOut])| -> u32 {
+                let mut onsets = 0u32;
+                for (p, o) in chunk.iter_mut().zip(out.iter_mut()) {
+                    onsets += pair_kernel(p, o, &ctx) as u32;
+                }
+                onsets
+            };
+            if parallel {
+                self.pairs
+                    .par_chunks_mut(PAIR_CHUNK)
+                    .zip(self.pair_out.par_chunks_mut(PAIR_CHUNK))
+                    .map(kernel)
+                    .collect_into_vec(&mut self.chunk_onsets);
+            } else {
+                self.chunk_onsets.clear();
+                let onsets = &mut self.chunk_onsets;
+                for chunk in self
+                    .pairs
+                    .chunks_mut(PAIR_CHUNK)
+                    .zip(self.pair_out.chunks_mut(PAIR_CHUNK))
+                {
+                    onsets.push(kernel(chunk));
+                }
+            }
+        }
+        // ---- particle phase
+        let stride = self.wall_stride;
+        {
+            let ctx = ParticleCtx {
+                pairs: &self.pairs,
+                pair_out: &self.pair_out,
+                csr_offset: &self.csr_offset,
+                csr_entry: &self.csr_entry,
+                radius: &self.radius,
+                mass: &self.mass,
+                inv_mass: &self.inv_mass,
+                inertia: &self.inertia,
+                inv_inertia: &self.inv_inertia,
+                material: &self.material,
+                alive: &self.alive,
+                reference_position: &self.reference_position,
+                walls: &self.walls,
+                wall_state: &self.wall_state,
+                laws: &self.laws,
+                n_materials: self.n_materials,
+                model: self.model,
+                effects: self.effects,
+                gravity: self.gravity,
+                clamp: self.clamp,
+                dt: self.dt,
+                wall_stride: stride,
+            };
+            if parallel {
+                self.position
+                    .par_chunks_mut(PARTICLE_CHUNK)
+                    .zip(self.velocity.par_chunks_mut(PARTICLE_CHUNK))
+                    .zip(self.omega.par_chunks_mut(PARTICLE_CHUNK))
+                    .zip(self.contact_force_sum.par_chunks_mut(PARTICLE_CHUNK))
+                    .zip(self.coordination.par_chunks_mut(PARTICLE_CHUNK))
+                    .zip(self.wall_coordination.par_chunks_mut(PARTICLE_CHUNK))
+                    .zip(self.wall_slots.par_chunks_mut(PARTICLE_CHUNK * stride))
+                    .enumerate()
+                    .map(|(c, ((((((x, v), w), f), z), zw), s))| {
+                        particle_chunk(&ctx, c * PARTICLE_CHUNK, x, v, w, f, z, zw, s)
+                    })
+                    .collect_into_vec(&mut self.chunk_results);
+            } else {
+                self.chunk_results.clear();
+                let iter = self
+                    .position
+                    .chunks_mut(PARTICLE_CHUNK)
+                    .zip(self.velocity.chunks_mut(PARTICLE_CHUNK))
+                    .zip(self.omega.chunks_mut(PARTICLE_CHUNK))
+                    .zip(self.contact_force_sum.chunks_mut(PARTICLE_CHUNK))
+                    .zip(self.coordination.chunks_mut(PARTICLE_CHUNK))
+                    .zip(self.wall_coordination.chunks_mut(PARTICLE_CHUNK))
+                    .zip(self.wall_slots.chunks_mut(PARTICLE_CHUNK * stride))
+                    .enumerate();
+                for (c, ((((((x, v), w), f), z), zw), s)) in iter {
+                    self.chunk_results.push(particle_chunk(
+                        &ctx,
+                        c * PARTICLE_CHUNK,
+                        x,
+                        v,
+                        w,
+                        f,
+                        z,
+                        zw,
+                        s,
+                    ));
+                }
+            }
+        }
+        let mut max_disp2: f64 = 0.0;
+        let mut bad = false;
+        let mut wall_onsets = 0u32;
+        for &(d, b, o) in &self.chunk_results {
+            max_disp2 = max_disp2.max(d);
+            bad |= b;
+            wall_onsets += o;
+        }
+        if self.record_onsets {
+            self.log_onsets(wall_onsets > 0);
+        }
+        self.steps += 1;
+        self.time = self.steps as f64 * self.dt;
+        if bad {
+            return Err(DemfemError::Numerical(format!(
+                "non-finite position or velocity at t = {} s (step {}); dt = {:e} s, stable limit {:e} s",
+                self.time, self.steps, self.dt, self.stable.limit
+            )));
+        }
+        if self.effects.has(Effect::MovingWalls) {
+            self.refresh_wall_state();
+        }
+        let half_skin = 0.5 * self.skin;
+        let mut moved = max_disp2 > half_skin * half_skin;
+        for (k, ws) in self.wall_state.iter().enumerate() {
+            moved |= (ws.offset - self.reference_wall_offset[k]).length() > half_skin;
+        }
+        self.needs_rebuild = moved;
+        if self.record_every > 0 && self.steps % self.record_every == 0 {
+            self.frames.push(self.frame());
+        }
+        Ok(())
+    }
+
+    fn log_onsets(&mut self, walls: bool) {
+        let time = self.time;
+        let step = self.steps;
+        for (c, &count) in self.chunk_onsets.iter().enumerate() {
+            if count == 0 {
+                continue;
+            }
+            let end = ((c + 1) * PAIR_CHUNK).min(self.pairs.len());
+            for p in &self.pairs[c * PAIR_CHUNK..end] {
+                if p.onset {
+                    self.onsets.push(ContactOnset {
+                        time,
+                        step,
+                        particle: p.i,
+                        partner: Partner::Particle(p.j),
+                        normal_speed: p.onset_normal_speed,
+                        tangential_speed: p.onset_tangential_speed,
+                        position: self.position_at_force_pass(p.i as usize),
+                        partner_position: self.position_at_force_pass(p.j as usize),
+                    });
+                }
+            }
+        }
+        if walls {
+            let stride = self.wall_stride;
+            for (k, s) in self.wall_slots.iter().enumerate() {
+                if s.wall != NO_WALL && s.onset {
+                    let i = k / stride;
+                    self.onsets.push(ContactOnset {
+                        time,
+                        step,
+                        particle: i as u32,
+                        partner: Partner::Wall(s.wall),
+                        normal_speed: s.onset_normal_speed,
+                        tangential_speed: s.onset_tangential_speed,
+                        position: self.position_at_force_pass(i),
+                        partner_position: s.point,
+                    });
+                }
+            }
+        }
+    }
+
+    /// Position at which the onset was detected: the force pass saw x(t), the particle phase
+    /// has since moved it by v Δt, so step back.
+    fn position_at_force_pass(&self, i: usize) -> Vec3 {
+        self.position[i] - self.velocity[i] * self.dt
+    }
+
+    /// The current state as a [`Frame`].
+    pub fn frame(&self) -> Frame {
+        Frame {
+            time: self.time,
+            step: self.steps,
+            position: self.position.clone(),
+            velocity: self.velocity.clone(),
+            angular_velocity: self.omega.clone(),
+            contact_force_sum: self.contact_force_sum.clone(),
+            coordination: self.coordination.clone(),
+            wall_contacts: self.wall_coordination.clone(),
+            alive: self.alive.clone(),
+        }
+    }
+
+    /// Active contacts at the last force evaluation.
+    pub fn contacts(&self) -> Vec<ContactRecord> {
+        let mut out = Vec::new();
+        for p in &self.pairs {
+            if p.active {
+                let i = p.i as usize;
+                let x_i = self.position[i] - self.velocity[i] * self.dt;
+                out.push(ContactRecord {
+                    particle: p.i,
+                    partner: Partner::Particle(p.j),
+                    normal: p.normal,
+                    normal_force: p.normal_force,
+                    tangential_force: p.force + p.normal_force * p.normal,
+                    overlap: p.overlap,
+                    point: x_i + (self.radius[i] - 0.5 * p.overlap) * p.normal,
+                });
+            }
+        }
+        for (k, s) in self.wall_slots.iter().enumerate() {
+            if s.wall != NO_WALL && s.active {
+                out.push(ContactRecord {
+                    particle: (k / self.wall_stride) as u32,
+                    partner: Partner::Wall(s.wall),
+                    normal: s.normal,
+                    normal_force: s.normal_force,
+                    tangential_force: s.force + s.normal_force * s.normal,
+                    overlap: s.overlap,
+                    point: s.point,
+                });
+            }
+        }
+        out
+    }
+
+    // ---- accessors
+    /// Simulated time, s.
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+    /// Steps taken.
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+    /// Time step, s.
+    pub fn dt(&self) -> f64 {
+        self.dt
+    }
+    /// The stable limit and what sets it.
+    pub fn stable_step(&self) -> &StableStep {
+        &self.stable
+    }
+    /// Worker threads the simulation was built with.
+    pub fn threads(&self) -> usize {
+        self.threads
+    }
+    /// Verlet skin, m.
+    pub fn skin(&self) -> f64 {
+        self.skin
+    }
+    /// Number of neighbour-list rebuilds so far.
+    pub fn rebuilds(&self) -> u64 {
+        self.rebuilds
+    }
+    /// Number of particles (alive or not).
+    pub fn len(&self) -> usize {
+        self.position.len()
+    }
+    /// Whether the simulation has no particle.
+    pub fn is_empty(&self) -> bool {
+        self.position.is_empty()
+    }
+    /// Centres, m.
+    pub fn positions(&self) -> &[Vec3] {
+        &self.position
+    }
+    /// Velocities (half step), m/s.
+    pub fn velocities(&self) -> &[Vec3] {
+        &self.velocity
+    }
+    /// Angular velocities (half step), rad/s.
+    pub fn angular_velocities(&self) -> &[Vec3] {
+        &self.omega
+    }
+    /// Radii, m.
+    pub fn radii(&self) -> &[f64] {
+        &self.radius
+    }
+    /// Masses, kg.
+    pub fn masses(&self) -> &[f64] {
+        &self.mass
+    }
+    /// Moments of inertia, kg m².
+    pub fn inertias(&self) -> &[f64] {
+        &self.inertia
+    }
+    /// Tags.
+    pub fn tags(&self) -> &[u32] {
+        &self.tag
+    }
+    /// Alive flags.
+    pub fn alive(&self) -> &[bool] {
+        &self.alive
+    }
+    /// Sum of contact forces on each particle at the last step, N.
+    pub fn contact_force_sums(&self) -> &[Vec3] {
+        &self.contact_force_sum
+    }
+    /// Particle–particle coordination number of each particle at the last step.
+    pub fn coordination(&self) -> &[u32] {
+        &self.coordination
+    }
+    /// Wall contacts of each particle at the last step.
+    pub fn wall_contact_counts(&self) -> &[u32] {
+        &self.wall_coordination
+    }
+    /// Recorded frames.
+    pub fn frames(&self) -> &[Frame] {
+        &self.frames
+    }
+    /// Logged contact onsets.
+    pub fn onsets(&self) -> &[ContactOnset] {
+        &self.onsets
+    }
+    /// Drop the recorded frames and onsets (e.g. after copying them out).
+    pub fn clear_records(&mut self) {
+        self.frames.clear();
+        self.onsets.clear();
+    }
+    /// Effects the step runs.
+    pub fn effects(&self) -> EffectSet {
+        self.effects
+    }
+    /// Pair law of materials a and b.
+    pub fn pair_law(&self, a: usize, b: usize) -> Option<&PairLaw> {
+        if a < self.n_materials && b < self.n_materials {
+            self.laws.get(a * self.n_materials + b)
+        } else {
+            None
+        }
+    }
+
+    /// (time in s, particle index) of every particle removed through the outlet plane.
+    pub fn removals(&self) -> &[(f64, u32)] {
+        &self.removals
+    }
+
+    /// Remove particle `i` from the simulation (it stops interacting and moving).
+    pub fn remove_particle(&mut self, i: usize) -> Result<()> {
+        if i >= self.position.len() {
+            return Err(DemfemError::invalid(
+                "particle index",
+                i as f64,
+                &format!("< {}", self.position.len()),
+            ));
+        }
+        self.alive[i] = false;
+        self.needs_rebuild = true;
+        Ok(())
+    }
+
+    /// Kinetic energy (translation + rotation) of the alive particles, J.
+    pub fn kinetic_energy(&self) -> f64 {
+        let mut e = 0.0;
+        for i in 0..self.position.len() {
+            if self.alive[i] {
+                e += 0.5 * self.mass[i] * self.velocity[i].length_squared()
+                    + 0.5 * self.inertia[i] * self.omega[i].length_squared();
+            }
+        }
+        e
+    }
+
+    /// Largest particle–particle or particle–wall overlap at the last step, m.
+    pub fn max_overlap(&self) -> f64 {
+        let a = self
+            .pairs
+            .iter()
+            .filter(|p| p.active)
+            .map(|p| p.overlap)
+            .fold(0.0, f64::max);
+        let b = self
+            .wall_slots
+            .iter()
+            .filter(|s| s.wall != NO_WALL && s.active)
+            .map(|s| s.overlap)
+            .fold(0.0, f64::max);
+        a.max(b)
+    }
+
+    /// Number of alive spheres whose centre is higher than `floor_z` + radius + `tolerance`
+    /// (m): spheres that ride on top of others, which an upright cartridge cannot do.
+    pub fn riding_up_count(&self, floor_z: f64, tolerance: f64) -> usize {
+        (0..self.position.len())
+            .filter(|&i| self.alive[i] && self.position[i].z > floor_z + self.radius[i] + tolerance)
+            .count()
+    }
+}
+
+/// Stable time step of a scene: the smaller of the Rayleigh step of every particle (Hertz
+/// laws only, where stiffness comes from E) and half the critical step 2/ω of the stiffest
+/// single contact at `expected_max_speed`, normal (ω² = k'_n/m*) and tangential
+/// (ω² = k_t/m_t, m_t = 2/7 m* with rotation: a rolling sphere's tangential inertia). The
+/// factor 1/2 allows for several simultaneous contacts (a dense lattice raises the highest
+/// eigenfrequency by up to about 2).
+pub fn stable_time_step(scene: &Scene, mass: &[f64]) -> Result<StableStep> {
+    let p = &scene.particles;
+    let v = scene.expected_max_speed;
+    let friction = scene.effects.has(Effect::Friction);
+    let rotation = scene.effects.has(Effect::Rotation);
+    let mut best = StableStep {
+        limit: f64::INFINITY,
+        reason: "no particle".into(),
+    };
+    let mut consider = |limit: f64, reason: &dyn Fn() -> String| {
+        if limit < best.limit {
+            best = StableStep {
+                limit,
+                reason: reason(),
+            };
+        }
+    };
+    // distinct (material, radius, mass) classes only: the table is usually monodisperse
+    let mut seen: Vec<(usize, u64)> = Vec::new();
+    let mut wall_materials: Vec<usize> = scene.walls.iter().map(|w| w.material).collect();
+    wall_materials.sort_unstable();
+    wall_materials.dedup();
+    for i in 0..p.len() {
+        let key = (p.material[i], p.radius[i].to_bits());
+        if seen.contains(&key) {
+            continue;
+        }
+        seen.push(key);
+        let mat = &scene.materials[p.material[i]];
+        let r = p.radius[i];
+        let m = mass[i];
+        if scene.model.is_hertzian() {
+            let t =
+                contact::rayleigh_time_step(r, mat.density, mat.young_modulus, mat.poisson_ratio)?;
+            consider(t, &|| {
+                format!(
+                    "Rayleigh step of particle {i} (r = {r} m, material {})",
+                    p.material[i]
+                )
+            });
+        }
+        let mut partners: Vec<(usize, f64, f64, String)> = vec![(
+            p.material[i],
+            0.5 * m,
+            0.5 * r,
+            format!("particle {i} against its twin"),
+        )];
+        for &wm in &wall_materials {
+            partners.push((
+                wm,
+                m,
+                r,
+                format!("particle {i} against a wall of material {wm}"),
+            ));
+        }
+        for (other, m_star, r_star, what) in partners {
+            let law = PairLaw::with_zeta(mat, &scene.materials[other], scene.model, 0.0)?;
+            let (k_n, k_t) = match scene.model {
+                ContactModel::LinearSpringDashpot {
+                    normal_stiffness,
+                    tangential_stiffness,
+                } => (normal_stiffness, tangential_stiffness),
+                _ => {
+                    // Hertz bounds Hertz–Reissner from above (the shell only softens)
+                    let k_h = contact::hertz_stiffness(r_star, law.e_star)?;
+                    let d = contact::hertz_max_overlap(k_h, m_star, v);
+                    (1.5 * k_h * d.sqrt(), 8.0 * law.g_star * (r_star * d).sqrt())
+                }
+            };
+            let dt_n = 0.5 * 2.0 * (m_star / k_n).sqrt();
+            consider(dt_n, &|| {
+                format!("normal contact stiffness, {what}, at {v} m/s")
+            });
+            if friction {
+                let m_t = if rotation { 2.0 / 7.0 * m_star } else { m_star };
+                let dt_t = 0.5 * 2.0 * (m_t / k_t).sqrt();
+                consider(dt_t, &|| {
+                    format!("tangential contact stiffness, {what}, at {v} m/s")
+                });
+            }
+        }
+    }
+    if !best.limit.is_finite() {
+        best.limit = f64::MAX;
+    }
+    Ok(best)
+}

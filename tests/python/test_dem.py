@@ -1,0 +1,97 @@
+"""DEM through the Python API: physics through the binding, errors, records, checkpoints."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from demfem import dem
+from demfem.errors import EffectError, ShapeError, UnstableTimeStepError
+
+R = 0.008
+GLASS = dem.material(45e9, 0.22, 2230.0, friction=0.2, restitution=0.5)
+TABLE_EFFECTS = ["gravity", "belt", "friction", "rotation", "damping"]
+
+
+def belt_sphere(**kw: object) -> dem.DemSimulation:
+    belt = dem.plane((0, 0, 0), (0, 0, 1), surface_velocity=(0.2, 0, 0))
+    return dem.DemSimulation(np.array([[0.0, 0.0, R]]), np.array([R]), [GLASS], [belt], TABLE_EFFECTS, **kw)
+
+
+def test_sphere_on_belt_rolls_at_two_sevenths():
+    # rolling without slip from rest: v = 2/7 V_belt (angular momentum about the contact point)
+    sim = belt_sphere(dt_safety=0.5)
+    seen = []
+    dem.run(sim, 0.08, progress=seen.append, report_every=0.0)
+    assert seen and seen[-1].time >= 0.08 and seen[-1].eta_seconds == 0.0
+    v = sim.velocities()[0]
+    assert v[0] == pytest.approx(2 / 7 * 0.2, rel=0.01)
+
+
+def test_missing_effect_and_bad_shapes_raise():
+    belt = dem.plane((0, 0, 0), (0, 0, 1), surface_velocity=(0.2, 0, 0))
+    with pytest.raises(EffectError, match="belt"):
+        dem.DemSimulation(np.array([[0.0, 0.0, R]]), np.array([R]), [GLASS], [belt],
+                          ["gravity", "friction", "rotation", "damping"])
+    with pytest.raises(ShapeError):
+        dem.DemSimulation(np.zeros((2, 2)), np.array([R, R]), [GLASS], [], [])
+    with pytest.raises(UnstableTimeStepError):
+        belt_sphere(dt=1e-3)
+
+
+def test_onsets_frames_and_contacts_are_arrays():
+    sim = belt_sphere(record_every=50, record_onsets=True)
+    sim.step(500)
+    f = sim.frames()
+    assert f["positions"].shape == (10, 1, 3) and f["coordination"].shape == (10, 1)
+    o = sim.onsets()
+    assert o["partner_is_wall"].all() and o["position"].shape[1] == 3
+    c = sim.contacts()
+    assert c["normal_force"][0] > 0 and c["partner_is_wall"][0]
+
+
+def test_checkpoint_restart_is_bitwise_identical(tmp_path):
+    a = belt_sphere()
+    a.step(3000)
+    path = tmp_path / "state.ck"
+    a.save_checkpoint(path)
+    a.step(3000)
+    b = belt_sphere()
+    b.load_checkpoint(str(path))
+    b.step(3000)
+    assert np.array_equal(a.positions(), b.positions())
+    assert np.array_equal(a.angular_velocities(), b.angular_velocities())
+
+
+def test_anchor_table_runs_and_reports_state():
+    sim = dem.DemSimulation.anchor_table(1e8, start="packed", threads=2)
+    assert len(sim) == 840 and sim.dt == pytest.approx(0.5 * R * (2230.0 / 1e8) ** 0.5)
+    sim.step(3000)  # the belt closes the 0.1 % gaps of the packing within ~40 ms
+    assert sim.positions().shape == (840, 3) and np.isfinite(sim.positions()).all()
+    assert sim.coordination().mean() > 1.0
+    assert sim.riding_up_count() == 0
+
+
+def test_outlet_plane_removes_particles():
+    belt = dem.plane((0, 0, 0), (0, 0, 1), surface_velocity=(0.2, 0, 0))
+    sim = dem.DemSimulation(np.array([[0.0, 0.0, R]]), np.array([R]), [GLASS], [belt], TABLE_EFFECTS,
+                            velocities=np.array([[0.2, 0.0, 0.0]]), removal_plane=((0.02, 0, 0), (-1, 0, 0)))
+    sim.run_until(0.5)
+    times, idx = sim.removals()
+    assert list(idx) == [0] and not sim.alive()[0] and 0.1 < times[0] < 0.5
+
+
+def test_ctrl_c_stops_cleanly_at_a_chunk_boundary():
+    import _thread
+    import threading
+
+    from demfem.errors import SimulationInterrupted
+
+    sim = dem.DemSimulation.anchor_table(1e8, start="square")
+    timer = threading.Timer(0.3, _thread.interrupt_main)  # what Ctrl-C does
+    timer.start()
+    with pytest.raises(SimulationInterrupted):
+        sim.step(10_000_000, chunk=100)
+    timer.cancel()
+    assert sim.steps % 100 == 0 and 0 < sim.steps < 10_000_000
+    assert np.isfinite(sim.positions()).all()
+    sim.step(100)  # and the simulation goes on
