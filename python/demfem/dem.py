@@ -32,7 +32,11 @@ __all__ = [
     "harmonic",
     "constant_velocity",
     "run",
+    "from_scene",
+    "CONTACT_MODELS",
 ]
+
+CONTACT_MODELS = ("hertz_mindlin", "hertz_reissner_mindlin", "linear")
 
 Vector = Sequence[float]
 
@@ -149,3 +153,109 @@ def run(
                 eta_seconds=(total - done) / rate if rate > 0 else float("inf"),
             ))
     return sim.steps - start_steps
+
+
+def from_scene(
+    scene: Any,
+    *,
+    model: str = "hertz_reissner_mindlin",
+    shell_thickness: Optional[float] = None,
+    shell_radius: Optional[float] = None,
+    dt: Optional[float] = None,
+    dt_safety: float = 0.2,
+    expected_max_speed: float = 1.0,
+    threads: int = 1,
+    record_every: int = 0,
+    record_onsets: bool = True,
+) -> DemSimulation:
+    """Build the engine from an engine-neutral scene description
+    (:class:`demfem.scenes.table.SceneDescription`).
+
+    ``model``: ``"hertz_reissner_mindlin"`` (default: the calibrated equivalent sphere of the
+    paper, Hertz in series with the Reissner stiffness of the cartridge wall, Mindlin
+    tangential spring), ``"hertz_mindlin"`` or ``"linear"``. The Reissner stiffness uses
+    ``shell_thickness`` and ``shell_radius`` (m; default: the default cartridge's wall
+    thickness and body mid-surface radius); walls do not bend (infinite shell stiffness).
+    ``dt`` (s) defaults to ``dt_safety`` times the stable limit; a larger one is refused.
+    Contact onsets are logged (``record_onsets``) because the FEM load cases come from them.
+    """
+    import numpy as np
+
+    from demfem.cartridge import Cartridge
+    from demfem.contact import reissner_stiffness
+    from demfem.errors import InvalidParameterError
+
+    if model not in CONTACT_MODELS:
+        raise InvalidParameterError(f"invalid model = {model!r}: must be one of {CONTACT_MODELS}")
+    if getattr(scene, "refeed", None):
+        raise InvalidParameterError(
+            "invalid refeed = True: the engine removes spheres through the outlet but cannot "
+            "re-insert them yet; run with refeed = False")
+    mats = scene.materials
+    pm = mats[scene.particle_material]
+    # the engine derives masses from density and radius: they must be the scene's masses
+    m_engine = pm["density"] * 4.0 / 3.0 * np.pi * np.asarray(scene.radii) ** 3
+    if not np.allclose(m_engine, scene.masses, rtol=1e-9, atol=0.0):
+        raise InvalidParameterError(
+            "invalid masses: the scene's sphere masses differ from density x sphere volume "
+            f"(e.g. {float(scene.masses[0]):.6g} kg vs {float(m_engine[0]):.6g} kg); "
+            "the equivalent sphere has the cartridge's mass and material, so both must agree")
+    k_r = float("inf")
+    if model == "hertz_reissner_mindlin":
+        c = Cartridge()
+        t = c.wall_thickness if shell_thickness is None else shell_thickness
+        r = c.body_mid_radius if shell_radius is None else shell_radius
+        k_r = reissner_stiffness(pm["young_modulus"], pm["poisson_ratio"], t, r)
+    names = [scene.particle_material] + [n for n in mats if n != scene.particle_material]
+    materials = [material(mats[n]["young_modulus"], mats[n]["poisson_ratio"], mats[n]["density"],
+                          friction=mats[n]["friction"], restitution=mats[n]["restitution"],
+                          rolling_friction=mats[n].get("rolling_resistance", 0.0),
+                          shell_stiffness=k_r if n == scene.particle_material else float("inf"))
+                 for n in names]
+    # walls are rigid: a copy of their material without a shell
+    wall_index: dict[str, int] = {}
+    for n in names:
+        wall_index[n] = len(materials)
+        materials.append({**materials[names.index(n)], "shell_stiffness": float("inf")})
+    walls = []
+    for w in scene.walls:
+        motion = w.get("motion") or {"kind": "fixed"}
+        kind = motion.get("kind", motion.get("type"))
+        if kind == "fixed":
+            mo = None
+        elif kind == "harmonic":
+            mo = harmonic(tuple(np.asarray(motion["direction"], float)), float(motion["amplitude"]),
+                          float(motion["period"]), float(motion.get("phase", 0.0)))
+        elif kind == "constant":
+            mo = constant_velocity(tuple(np.asarray(motion["velocity"], float)))
+        else:
+            raise InvalidParameterError(f"invalid wall {w.get('name')!r} motion kind = {kind!r}: "
+                                        "must be 'fixed', 'harmonic' or 'constant'")
+        sv = w.get("surface_velocity")
+        sv = None if sv is None or not np.any(np.asarray(sv)) else tuple(np.asarray(sv, float))
+        mat = wall_index[w.get("material", scene.particle_material)]
+        if w["kind"] == "plane":
+            walls.append(plane(tuple(np.asarray(w["point"], float)), tuple(np.asarray(w["normal"], float)),
+                               material=mat, surface_velocity=sv, motion=mo))
+        elif w["kind"] == "polygon":
+            walls.append(polygon([list(map(float, v)) for v in np.asarray(w["vertices"])],
+                                 material=mat, surface_velocity=sv, motion=mo))
+        else:
+            raise InvalidParameterError(f"invalid wall {w.get('name')!r} kind = {w['kind']!r}: "
+                                        "must be 'plane' or 'polygon'")
+    removal = scene.removal
+    removal_plane = None
+    if removal is not None:
+        # the scene's normal points to the removed side, the engine's to the kept side
+        removal_plane = (tuple(np.asarray(removal["point"], float)),
+                         tuple(-np.asarray(removal["normal"], float)))
+    return DemSimulation(
+        np.ascontiguousarray(scene.positions, dtype=float),
+        np.ascontiguousarray(scene.radii, dtype=float),
+        materials, walls, list(scene.effects),
+        tags=np.asarray(scene.tags, dtype=np.int64),
+        gravity=tuple(float(g) for g in scene.gravity),
+        model=model, dt=dt, dt_safety=dt_safety, expected_max_speed=expected_max_speed,
+        threads=threads, record_every=record_every, record_onsets=record_onsets,
+        removal_plane=removal_plane,
+    )
