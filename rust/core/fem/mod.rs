@@ -1,2 +1,22 @@
 //! Explicit finite elements: cartridge meshes, linear tetrahedra and thin shells, explicit
 //! central-difference dynamics, stress recovery and a sparse static solve.
+//!
+//! Layout (fenris style): [`mesh`] builds and checks meshes, [`element`] holds the element
+//! kernels, [`assembly`] turns element quantities into global ones (lumped mass, sparse
+//! stiffness, surface loads), [`explicit`] integrates in time, [`stable_step`] bounds the
+//! critical time step, [`static_solve`] factorises the sparse stiffness, [`stress`] recovers
+//! stresses and [`io`] writes VTK files. All quantities are SI.
+
+pub mod assembly;
+pub mod element;
+pub mod explicit;
+pub mod io;
+pub mod material;
+pub mod mesh;
+pub mod stable_step;
+pub mod static_solve;
+pub mod stress;
+
+pub use explicit::{ExplicitConfig, ExplicitSolver, EnergyReport, Prescribed, PrescribedKind, LoadHistory};
+pub use material::LinearElastic;
+pub use mesh::{AxisymmetricProfile, MeshQuality, TetMesh, TriMesh};
