@@ -24,7 +24,7 @@ use crate::fem::assembly::{lumped_mass, precompute_tets, NodeAdjacency};
 use crate::fem::element::Tet4;
 use crate::fem::material::LinearElastic;
 use crate::fem::mesh::TetMesh;
-use crate::fem::stable_step::{critical_step_from_eigenvalue, element_eigenvalue_bound, mass_scaling_factors};
+use crate::fem::stable_step::{certified_eigenvalue_bound, critical_step_from_eigenvalue, mass_scaling_factors, EigenvalueBound, StepBound};
 
 /// Elements per parallel work item (fixed, so chunking does not depend on the thread count).
 const ELEMENT_CHUNK: usize = 2048;
@@ -116,6 +116,8 @@ pub struct ExplicitConfig {
     pub mass_scaling_dt: Option<f64>,
     /// Record an [`EnergyReport`] every this many steps (0 = do not record a history).
     pub energy_interval: usize,
+    /// How the critical step is bounded (both ways are proven safe).
+    pub step_bound: StepBound,
 }
 
 impl ExplicitConfig {
@@ -129,6 +131,7 @@ impl ExplicitConfig {
             rayleigh_beta: 0.0,
             mass_scaling_dt: None,
             energy_interval: 100,
+            step_bound: StepBound::CertifiedGlobal { margin: 0.01, iterations: 400 },
         }
     }
 }
@@ -325,6 +328,7 @@ pub struct ExplicitSolver {
     dt: f64,
     dt_limit: f64,
     critical_element: usize,
+    eigen: EigenvalueBound,
     // Per-dof boundary conditions: 0 free, 1 displacement, 2 velocity.
     bc_kind: Vec<[u8; 3]>,
     bc_value: Vec<[f64; 3]>,
@@ -365,8 +369,10 @@ impl ExplicitSolver {
             None => (None, 0.0),
         };
         let mass = lumped_mass(mesh, kernel.tets(), rho, factors.as_deref())?;
-        let (lam_max, critical_element) = element_eigenvalue_bound(kernel.tets(), lambda, mu, rho, factors.as_deref());
-        let dt_limit = critical_step_from_eigenvalue(lam_max, config.rayleigh_alpha, config.rayleigh_beta)?;
+        let mut kernel = kernel;
+        let eigen = certified_eigenvalue_bound(mesh, &mut kernel, &mass, &config.material, factors.as_deref(), config.step_bound)?;
+        let critical_element = eigen.critical_element;
+        let dt_limit = critical_step_from_eigenvalue(eigen.bound, config.rayleigh_alpha, config.rayleigh_beta)?;
         let dt = match config.dt {
             Some(dt) => {
                 check_positive("dt", dt)?;
@@ -374,7 +380,10 @@ impl ExplicitSolver {
                     return Err(DemfemError::UnstableTimeStep {
                         dt,
                         limit: dt_limit,
-                        reason: format!("element eigenvalue bound of tet {critical_element} (with Rayleigh damping)"),
+                        reason: format!(
+                            "bound {:e} 1/s² on λ_max(M⁻¹K) ({} factorisations; element bound {:e} at tet {critical_element}), with Rayleigh damping",
+                            eigen.bound, eigen.factorizations, eigen.element_bound
+                        ),
                     });
                 }
                 dt
@@ -391,6 +400,7 @@ impl ExplicitSolver {
             dt,
             dt_limit,
             critical_element,
+            eigen,
             bc_kind: vec![[0; 3]; n],
             bc_value: z.clone(),
             bc_history: LoadHistory::Constant,
@@ -503,7 +513,11 @@ impl ExplicitSolver {
     pub fn dt_limit(&self) -> f64 {
         self.dt_limit
     }
-    /// Element that sets the bound.
+    /// The eigenvalue bound behind [`Self::dt_limit`].
+    pub fn eigenvalue_bound(&self) -> EigenvalueBound {
+        self.eigen
+    }
+    /// Element that sets the element bound.
     pub fn critical_element(&self) -> usize {
         self.critical_element
     }

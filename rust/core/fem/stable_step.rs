@@ -69,3 +69,84 @@ pub fn mass_scaling_factors(tets: &[Tet4], lambda: f64, mu: f64, density: f64, t
     }
     Ok((f, added))
 }
+
+/// How the solver bounds the largest eigenvalue of M⁻¹K.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum StepBound {
+    /// max_e λ_max(M_e⁻¹K_e): cheap and always safe, but 15–25 % below the true critical
+    /// step on typical tet meshes.
+    ElementEigenvalue,
+    /// Power-iteration estimate λ_p of the global λ_max (from below), raised to
+    /// σ = λ_p(1 + margin·2^k) until a sparse Cholesky factorisation of σM − K succeeds,
+    /// which proves σ > λ_max (σM − K is positive definite iff σ exceeds every
+    /// eigenvalue). Capped by the element bound. Within `margin` of the true step, at the
+    /// cost of one or a few sparse factorisations.
+    CertifiedGlobal {
+        /// Relative margin added to the power-iteration estimate, e.g. 0.01.
+        margin: f64,
+        /// Power iterations, e.g. 500.
+        iterations: usize,
+    },
+}
+
+/// Result of [`certified_eigenvalue_bound`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EigenvalueBound {
+    /// Proven upper bound on λ_max(M⁻¹K), 1/s².
+    pub bound: f64,
+    /// Element eigenvalue bound, 1/s².
+    pub element_bound: f64,
+    /// Power-iteration estimate (a lower bound up to round-off), 1/s²; 0 if not computed.
+    pub power_estimate: f64,
+    /// Cholesky factorisations tried.
+    pub factorizations: usize,
+    /// Element attaining the element bound.
+    pub critical_element: usize,
+}
+
+/// Proven upper bound on λ_max(M⁻¹K) for the lumped masses `mass` (kg per node), see
+/// [`StepBound`]. `mass_factor` is the per-element mass scaling used to build `mass`.
+pub fn certified_eigenvalue_bound(
+    mesh: &crate::fem::mesh::TetMesh,
+    kernel: &mut crate::fem::explicit::TetForceKernel,
+    mass: &[f64],
+    material: &crate::fem::material::LinearElastic,
+    mass_factor: Option<&[f64]>,
+    how: StepBound,
+) -> Result<EigenvalueBound> {
+    use faer::sparse::{SparseColMat, Triplet};
+    let (lambda, mu) = material.lame();
+    let (lam_e, crit) = element_eigenvalue_bound(kernel.tets(), lambda, mu, material.density, mass_factor);
+    let mut out = EigenvalueBound { bound: lam_e, element_bound: lam_e, power_estimate: 0.0, factorizations: 0, critical_element: crit };
+    let (margin, iterations) = match how {
+        StepBound::ElementEigenvalue => return Ok(out),
+        StepBound::CertifiedGlobal { margin, iterations } => (crate::error::check_positive("margin", margin)?, iterations),
+    };
+    let lam_p = crate::fem::explicit::global_max_eigenvalue(kernel, mass, iterations.max(1))?;
+    out.power_estimate = lam_p;
+    let trips = crate::fem::assembly::stiffness_triplets(mesh, kernel.tets(), lambda, mu, true);
+    let nd = 3 * mass.len();
+    let mut k = 0;
+    loop {
+        let sigma = lam_p * (1.0 + margin * f64::powi(2.0, k));
+        if !(sigma < lam_e) {
+            return Ok(out);
+        }
+        let mut t: Vec<Triplet<usize, usize, f64>> = trips.iter().map(|&(r, c, v)| Triplet::new(r, c, -v)).collect();
+        t.extend((0..nd).map(|d| Triplet::new(d, d, sigma * mass[d / 3])));
+        let a = SparseColMat::<usize, f64>::try_new_from_triplets(nd, nd, &t)
+            .map_err(|e| DemfemError::Numerical(format!("assembling σM − K failed: {e:?}")))?;
+        out.factorizations += 1;
+        match a.sp_cholesky(faer::Side::Lower) {
+            Ok(_) => {
+                out.bound = sigma;
+                return Ok(out);
+            }
+            Err(faer::sparse::linalg::LltError::Numeric(_)) => k += 1,
+            Err(e) => return Err(DemfemError::Numerical(format!("factorising σM − K failed: {e:?}"))),
+        }
+        if k > 30 {
+            return Ok(out);
+        }
+    }
+}
