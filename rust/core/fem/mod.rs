@@ -3,7 +3,7 @@
 //!
 //! Layout (fenris style): [`mesh`] builds and checks meshes, [`element`] holds the element
 //! kernels, [`assembly`] turns element quantities into global ones (lumped mass, sparse
-//! stiffness, surface loads), [`explicit`] integrates in time, [`stable_step`] bounds the
+//! stiffness, surface loads), [`shell`] assembles and solves thin-shell models, [`explicit`] integrates in time, [`stable_step`] bounds the
 //! critical time step, [`static_solve`] factorises the sparse stiffness, [`stress`] recovers
 //! stresses and [`io`] writes VTK files. All quantities are SI.
 
@@ -13,6 +13,7 @@ pub mod explicit;
 pub mod io;
 pub mod material;
 pub mod mesh;
+pub mod shell;
 pub mod stable_step;
 pub mod static_solve;
 pub mod stress;

@@ -43,6 +43,23 @@ pub fn solve_static(mesh: &TetMesh, material: &LinearElastic, loads: &[[f64; 3]]
         }
         fixed[3 * node + c] = Some(v);
     }
+    let (lambda, mu) = material.lame();
+    let tets = precompute_tets(mesh)?;
+    let trips = stiffness_triplets(mesh, &tets, lambda, mu, false);
+    let f: Vec<f64> = loads.iter().flatten().cloned().collect();
+    let (x, r) = solve_constrained(ndof, &trips, &f, &fixed)?;
+    let to3 = |v: &[f64]| v.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect::<Vec<[f64; 3]>>();
+    let (u, reaction) = (to3(&x), to3(&r));
+    Ok(StaticSolution { displacement: u, reaction })
+}
+
+/// Solve K x = f for a symmetric positive definite K given as full (both triangles)
+/// triplets (row, col, value; duplicates summed) of size `ndof`, with `fixed[d] = Some(v)`
+/// prescribing dof d. Returns (x, reactions K x − f at fixed dofs, 0 elsewhere).
+pub fn solve_constrained(ndof: usize, trips: &[(usize, usize, f64)], f: &[f64], fixed: &[Option<f64>]) -> Result<(Vec<f64>, Vec<f64>)> {
+    if f.len() != ndof || fixed.len() != ndof {
+        return Err(DemfemError::ShapeMismatch { field: "rhs".into(), detail: format!("expected {ndof} dofs") });
+    }
     let mut free_index = vec![usize::MAX; ndof];
     let mut nf = 0;
     for d in 0..ndof {
@@ -51,17 +68,17 @@ pub fn solve_static(mesh: &TetMesh, material: &LinearElastic, loads: &[[f64; 3]]
             nf += 1;
         }
     }
-    let (lambda, mu) = material.lame();
-    let tets = precompute_tets(mesh)?;
-    let trips = stiffness_triplets(mesh, &tets, lambda, mu, false);
     let mut rhs = Mat::<f64>::zeros(nf, 1);
     for d in 0..ndof {
         if free_index[d] != usize::MAX {
-            rhs[(free_index[d], 0)] = loads[d / 3][d % 3];
+            rhs[(free_index[d], 0)] = f[d];
         }
     }
     let mut lower = Vec::with_capacity(trips.len() / 2 + ndof);
-    for &(r, c, v) in &trips {
+    for &(r, c, v) in trips {
+        if r >= ndof || c >= ndof {
+            return Err(DemfemError::ShapeMismatch { field: "triplets".into(), detail: format!("index ({r}, {c}) >= {ndof}") });
+        }
         match (free_index[r] != usize::MAX, free_index[c] != usize::MAX) {
             (true, true) => {
                 if free_index[r] >= free_index[c] {
@@ -76,7 +93,6 @@ pub fn solve_static(mesh: &TetMesh, material: &LinearElastic, loads: &[[f64; 3]]
             _ => {}
         }
     }
-    let mut u = vec![[0.0; 3]; n];
     if nf > 0 {
         let k = SparseColMat::<usize, f64>::try_new_from_triplets(nf, nf, &lower)
             .map_err(|e| DemfemError::Numerical(format!("sparse stiffness assembly failed: {e:?}")))?;
@@ -85,26 +101,20 @@ pub fn solve_static(mesh: &TetMesh, material: &LinearElastic, loads: &[[f64; 3]]
             .map_err(|e| DemfemError::Numerical(format!("stiffness not positive definite (insufficient supports?): {e:?}")))?;
         llt.solve_in_place(rhs.as_mut());
     }
-    for d in 0..ndof {
-        u[d / 3][d % 3] = match fixed[d] {
-            Some(v) => v,
-            None => rhs[(free_index[d], 0)],
-        };
-    }
-    if u.iter().flatten().any(|x| !x.is_finite()) {
+    let x: Vec<f64> = (0..ndof).map(|d| fixed[d].unwrap_or_else(|| rhs[(free_index[d], 0)])).collect();
+    if x.iter().any(|v| !v.is_finite()) {
         return Err(DemfemError::Numerical("static solve produced non-finite displacements".into()));
     }
-    // Reactions from K u − f at the prescribed dofs.
-    let mut reaction = vec![[0.0; 3]; n];
-    for &(r, c, v) in &trips {
+    let mut reaction = vec![0.0; ndof];
+    for &(r, c, v) in trips {
         if fixed[r].is_some() {
-            reaction[r / 3][r % 3] += v * u[c / 3][c % 3];
+            reaction[r] += v * x[c];
         }
     }
     for d in 0..ndof {
         if fixed[d].is_some() {
-            reaction[d / 3][d % 3] -= loads[d / 3][d % 3];
+            reaction[d] -= f[d];
         }
     }
-    Ok(StaticSolution { displacement: u, reaction })
+    Ok((x, reaction))
 }
