@@ -18,7 +18,7 @@ pub type ShellMatrix = SMatrix<f64, 18, 18>;
 type Mat9 = SMatrix<f64, 9, 9>;
 type Mat3x9 = SMatrix<f64, 3, 9>;
 
-/// Fictitious drilling stiffness as a fraction of the largest bending diagonal term.
+/// Fictitious drilling stiffness as a fraction of the largest bending rotation diagonal term.
 const DRILLING_FRACTION: f64 = 1e-3;
 
 /// Precomputed geometry of one flat shell triangle.
@@ -177,7 +177,8 @@ impl ShellTri {
             }
         }
         // Drilling: rows sum to zero, so a uniform θz costs nothing.
-        let kd = DRILLING_FRACTION * (0..9).map(|i| kb[(i, i)]).fold(0.0, f64::max);
+        // Scaled by the bending *rotation* diagonal terms (N·m), not the w terms (N/m).
+        let kd = DRILLING_FRACTION * (0..3).flat_map(|a| [kb[(3 * a + 1, 3 * a + 1)], kb[(3 * a + 2, 3 * a + 2)]]).fold(0.0, f64::max);
         for a in 0..3 {
             for b in 0..3 {
                 k[(6 * a + 5, 6 * b + 5)] = if a == b { kd } else { -0.5 * kd };
