@@ -9,6 +9,8 @@ use pyo3::prelude::*;
 use demfem::contact::{self, ForceClamp, NormalLaw};
 use demfem::DemfemError;
 
+mod fem;
+
 create_exception!(_core, DemfemErrorPy, PyException, "Base class of every demfem error.");
 create_exception!(_core, InvalidParameterError, PyValueError, "A value outside its allowed range (also a ValueError).");
 create_exception!(_core, UnstableTimeStepError, PyValueError, "A time step above the stable limit (also a ValueError).");
@@ -159,5 +161,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(tsuji_damping_for_restitution, m)?)?;
     m.add_function(wrap_pyfunction!(rayleigh_time_step, m)?)?;
     m.add_function(wrap_pyfunction!(hertz_contact_duration, m)?)?;
+    fem::register(m)?;
     Ok(())
 }
