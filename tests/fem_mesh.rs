@@ -119,5 +119,11 @@ fn vtk_files_are_written_atomically() {
     // Wrong array length is an error, not a panic.
     let bad = write_vtu(&dir.join("bad.vtu"), &m.nodes, &m.tets, &[DataArray { name: "x", n_components: 3, values: &s1 }], &[]);
     assert!(matches!(bad, Err(DemfemError::ShapeMismatch { .. })));
+    // Shell mid-surface as VTK triangles (cell type 5).
+    let sm = AxisymmetricProfile::default_cartridge().shell_mesh(12, 2e-3).unwrap();
+    let th: Vec<f64> = sm.thickness.clone();
+    demfem::fem::io::vtk::write_vtu_triangles(&dir.join("shell.vtu"), &sm.nodes, &sm.triangles, &[], &[DataArray { name: "thickness", n_components: 1, values: &th }]).unwrap();
+    let st = std::fs::read_to_string(dir.join("shell.vtu")).unwrap();
+    assert_eq!(st.matches("          5\n").count(), sm.triangles.len());
     std::fs::remove_dir_all(&dir).unwrap();
 }

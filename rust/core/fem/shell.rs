@@ -149,7 +149,16 @@ impl ShellExplicit {
         use nalgebra::SymmetricEigen;
         let nn = model.mesh.nodes.len();
         let (e, nu, rho) = (model.material.youngs_modulus, model.material.poisson_ratio, model.material.density);
-        let k_e: Vec<_> = model.elements.iter().map(|el| el.global_stiffness(e, nu)).collect();
+        // Symmetrised exactly, so K_e u can be evaluated as columns · u (contiguous in
+        // nalgebra's column-major storage).
+        let k_e: Vec<_> = model
+            .elements
+            .iter()
+            .map(|el| {
+                let k = el.global_stiffness(e, nu);
+                (k + k.transpose()) * 0.5
+            })
+            .collect();
         let mut mass = vec![0.0; 6 * nn];
         let mut lam_max: f64 = 0.0;
         for ((t, el), k) in model.mesh.triangles.iter().zip(&model.elements).zip(&k_e) {
@@ -263,13 +272,14 @@ impl ShellExplicit {
             for a in 0..3 {
                 ue[6 * a..6 * a + 6].copy_from_slice(&u[6 * t[a]..6 * t[a] + 6]);
             }
-            let k = &k_e[e];
-            for i in 0..18 {
+            let k = k_e[e].as_slice();
+            for (i, o) in out.iter_mut().enumerate() {
+                let col = &k[18 * i..18 * i + 18];
                 let mut s = 0.0;
                 for j in 0..18 {
-                    s += k[(i, j)] * ue[j];
+                    s += col[j] * ue[j];
                 }
-                out[i] = s;
+                *o = s;
             }
         });
         let (buffer, adj) = (&self.buffer, &self.adjacency);

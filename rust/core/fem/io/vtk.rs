@@ -61,35 +61,59 @@ fn write_array(out: &mut String, a: &DataArray<'_>, n_entries: usize) -> Result<
 
 /// Write a tetrahedral mesh with point and cell data to a `.vtu` file.
 pub fn write_vtu(path: &Path, nodes: &[[f64; 3]], tets: &[[usize; 4]], point_data: &[DataArray<'_>], cell_data: &[DataArray<'_>]) -> Result<()> {
-    let mut s = String::with_capacity(64 * nodes.len() + 64 * tets.len());
+    let flat: Vec<usize> = tets.iter().flatten().cloned().collect();
+    write_cells(path, nodes, &flat, 4, 10, point_data, cell_data)
+}
+
+/// Write a triangle (shell mid-surface) mesh with point and cell data to a `.vtu` file.
+pub fn write_vtu_triangles(path: &Path, nodes: &[[f64; 3]], triangles: &[[usize; 3]], point_data: &[DataArray<'_>], cell_data: &[DataArray<'_>]) -> Result<()> {
+    let flat: Vec<usize> = triangles.iter().flatten().cloned().collect();
+    write_cells(path, nodes, &flat, 3, 5, point_data, cell_data)
+}
+
+fn write_cells(
+    path: &Path,
+    nodes: &[[f64; 3]],
+    conn: &[usize],
+    per_cell: usize,
+    vtk_type: u8,
+    point_data: &[DataArray<'_>],
+    cell_data: &[DataArray<'_>],
+) -> Result<()> {
+    let n_cells = conn.len() / per_cell;
+    let mut s = String::with_capacity(64 * nodes.len() + 64 * n_cells);
     s.push_str("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\">\n  <UnstructuredGrid>\n");
-    let _ = writeln!(s, r#"    <Piece NumberOfPoints="{}" NumberOfCells="{}">"#, nodes.len(), tets.len());
+    let _ = writeln!(s, r#"    <Piece NumberOfPoints="{}" NumberOfCells="{}">"#, nodes.len(), n_cells);
     s.push_str("      <PointData>\n");
     for a in point_data {
         write_array(&mut s, a, nodes.len())?;
     }
     s.push_str("      </PointData>\n      <CellData>\n");
     for a in cell_data {
-        write_array(&mut s, a, tets.len())?;
+        write_array(&mut s, a, n_cells)?;
     }
     s.push_str("      </CellData>\n      <Points>\n        <DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n");
     for p in nodes {
         let _ = writeln!(s, "          {:e} {:e} {:e}", p[0], p[1], p[2]);
     }
     s.push_str("        </DataArray>\n      </Points>\n      <Cells>\n        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n");
-    for t in tets {
-        if t.iter().any(|&i| i >= nodes.len()) {
-            return Err(DemfemError::ShapeMismatch { field: "tets".into(), detail: "node index out of range".into() });
+    for c in conn.chunks_exact(per_cell) {
+        if c.iter().any(|&i| i >= nodes.len()) {
+            return Err(DemfemError::ShapeMismatch { field: "cells".into(), detail: "node index out of range".into() });
         }
-        let _ = writeln!(s, "          {} {} {} {}", t[0], t[1], t[2], t[3]);
+        s.push_str("         ");
+        for i in c {
+            let _ = write!(s, " {i}");
+        }
+        s.push('\n');
     }
     s.push_str("        </DataArray>\n        <DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n");
-    for i in 0..tets.len() {
-        let _ = writeln!(s, "          {}", 4 * (i + 1));
+    for i in 0..n_cells {
+        let _ = writeln!(s, "          {}", per_cell * (i + 1));
     }
     s.push_str("        </DataArray>\n        <DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n");
-    for _ in 0..tets.len() {
-        s.push_str("          10\n");
+    for _ in 0..n_cells {
+        let _ = writeln!(s, "          {vtk_type}");
     }
     s.push_str("        </DataArray>\n      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n");
     write_atomic(path, &s)
