@@ -1,6 +1,7 @@
 //! Patch tests: a linear displacement field (constant strain) must be reproduced exactly by
 //! linear tetrahedra on a distorted mesh, in the static solve and in explicit dynamics;
 //! and the explicit solver must be bitwise deterministic for 1 and 2 threads.
+#![allow(clippy::needless_range_loop)]
 
 use demfem::fem::mesh::{box_tet_mesh, TetMesh};
 use demfem::fem::static_solve::solve_static;

@@ -2,6 +2,7 @@
 //! (MacNeal & Harder 1985; Belytschko et al. 1985): Scordelis–Lo roof, pinched cylinder
 //! with end diaphragms, pinched hemisphere with an 18° hole. Each prints a convergence
 //! table; the finest mesh must be within 3 % of the reference value.
+#![allow(clippy::needless_range_loop)]
 
 use demfem::fem::element::ShellTri;
 use demfem::fem::mesh::TriMesh;

@@ -80,10 +80,8 @@ pub fn solve_constrained(ndof: usize, trips: &[(usize, usize, f64)], f: &[f64], 
             return Err(DemfemError::ShapeMismatch { field: "triplets".into(), detail: format!("index ({r}, {c}) >= {ndof}") });
         }
         match (free_index[r] != usize::MAX, free_index[c] != usize::MAX) {
-            (true, true) => {
-                if free_index[r] >= free_index[c] {
-                    lower.push(Triplet::new(free_index[r], free_index[c], v));
-                }
+            (true, true) if free_index[r] >= free_index[c] => {
+                lower.push(Triplet::new(free_index[r], free_index[c], v));
             }
             (true, false) => {
                 if let Some(uc) = fixed[c] {
