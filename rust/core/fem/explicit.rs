@@ -622,51 +622,26 @@ impl ExplicitSolver {
         }
         let lf = self.load_history.factor(t);
         let bf_next = self.bc_history.factor(t + dt);
-        let need_damp = alpha > 0.0 || beta > 0.0;
-        {
-            let mass = &self.mass;
-            let loads = &self.loads;
-            let extra = &self.extra_loads;
-            let v = &self.v;
-            self.f_damp
-                .par_chunks_mut(NODE_CHUNK)
-                .zip(self.f_ext.par_chunks_mut(NODE_CHUNK))
-                .enumerate()
-                .for_each(|(c, (fd, fe))| {
-                    let n0 = c * NODE_CHUNK;
-                    for k in 0..fd.len() {
-                        let i = n0 + k;
-                        for d in 0..3 {
-                            // βK v is already in fd when β > 0; add αM v.
-                            let stiff = if beta > 0.0 { fd[k][d] } else { 0.0 };
-                            fd[k][d] = if need_damp { stiff + alpha * mass[i] * v[i][d] } else { 0.0 };
-                            fe[k][d] = loads[i][d] * lf + extra[i][d];
-                        }
-                    }
-                });
-        }
-        // Velocity update, reactions and energies at t^n.
-        let mut e_kin = 0.0;
-        let mut w_ext = 0.0;
-        let mut w_damp = 0.0;
-        let mut e_int = 0.0;
-        let n_nodes = self.mass.len();
-        let n_chunks = n_nodes.div_ceil(NODE_CHUNK);
+        // One fused, deterministic pass over nodes: damping and external forces at t^n,
+        // velocity update (free or prescribed), reactions, energy increments, and the
+        // displacement update. Partial sums per fixed chunk are added in chunk order.
         let partial: Vec<[f64; 4]> = {
             let mass = &self.mass;
             let f_int = &self.f_int;
-            let f_damp = &self.f_damp;
-            let f_ext = &self.f_ext;
+            let loads = &self.loads;
+            let extra = &self.extra_loads;
             let bc_kind = &self.bc_kind;
             let bc_value = &self.bc_value;
-            let u = &self.u;
-            let du_prev = &self.du_prev;
-            let f_damp_prev = &self.f_damp_prev;
             self.v
                 .par_chunks_mut(NODE_CHUNK)
+                .zip(self.u.par_chunks_mut(NODE_CHUNK))
+                .zip(self.du_prev.par_chunks_mut(NODE_CHUNK))
                 .zip(self.f_total_prev.par_chunks_mut(NODE_CHUNK))
+                .zip(self.f_damp.par_chunks_mut(NODE_CHUNK))
+                .zip(self.f_damp_prev.par_chunks_mut(NODE_CHUNK))
+                .zip(self.f_ext.par_chunks_mut(NODE_CHUNK))
                 .enumerate()
-                .map(|(c, (vc, ftp))| {
+                .map(|(c, ((((((vc, uc), duc), ftp), fd), fdp), fe))| {
                     let n0 = c * NODE_CHUNK;
                     let mut acc = [0.0f64; 4];
                     for k in 0..vc.len() {
@@ -674,30 +649,40 @@ impl ExplicitSolver {
                         let m = mass[i];
                         for d in 0..3 {
                             let v_old = vc[k][d];
-                            let resid = f_ext[i][d] - f_int[i][d] - f_damp[i][d];
+                            // βK v^{n−½} is in fd when β > 0; add αM v^{n−½}.
+                            let stiff = if beta > 0.0 { fd[k][d] } else { 0.0 };
+                            let damp = stiff + alpha * m * v_old;
+                            let f_ext = loads[i][d] * lf + extra[i][d];
+                            fe[k][d] = f_ext;
+                            let resid = f_ext - f_int[i][d] - damp;
+                            let u_old = uc[k][d];
                             let (v_new, reaction) = match bc_kind[i][d] {
                                 0 => (v_old + dt_n * resid / m, 0.0),
                                 kind => {
-                                    let vn = if kind == 1 { (bc_value[i][d] * bf_next - u[i][d]) / dt } else { bc_value[i][d] };
+                                    let vn = if kind == 1 { (bc_value[i][d] * bf_next - u_old) / dt } else { bc_value[i][d] };
                                     let a = (vn - v_old) / dt_n;
                                     (vn, m * a - resid)
                                 }
                             };
-                            let f_total = f_ext[i][d] + reaction;
+                            let f_total = f_ext + reaction;
                             let v_prev = if first { 2.0 * v_old - v_new } else { v_old };
                             acc[0] += 0.5 * m * v_prev * v_new;
-                            acc[1] += 0.5 * du_prev[i][d] * (ftp[k][d] + f_total);
-                            acc[2] += 0.5 * du_prev[i][d] * (f_damp_prev[i][d] + f_damp[i][d]);
-                            acc[3] += 0.5 * u[i][d] * f_int[i][d];
+                            acc[1] += 0.5 * duc[k][d] * (ftp[k][d] + f_total);
+                            acc[2] += 0.5 * duc[k][d] * (fdp[k][d] + damp);
+                            acc[3] += 0.5 * u_old * f_int[i][d];
                             vc[k][d] = v_new;
                             ftp[k][d] = f_total;
+                            fdp[k][d] = damp;
+                            let du = dt * v_new;
+                            uc[k][d] = u_old + du;
+                            duc[k][d] = du;
                         }
                     }
                     acc
                 })
                 .collect()
         };
-        debug_assert_eq!(partial.len(), n_chunks);
+        let (mut e_kin, mut w_ext, mut w_damp, mut e_int) = (0.0, 0.0, 0.0, 0.0);
         for p in &partial {
             e_kin += p[0];
             w_ext += p[1];
@@ -716,25 +701,6 @@ impl ExplicitSolver {
         if ei > 0 && self.steps % ei as u64 == 0 {
             self.history.push(self.energy);
         }
-        // Displacement update.
-        {
-            let v = &self.v;
-            self.u
-                .par_chunks_mut(NODE_CHUNK)
-                .zip(self.du_prev.par_chunks_mut(NODE_CHUNK))
-                .enumerate()
-                .for_each(|(c, (uc, duc))| {
-                    let n0 = c * NODE_CHUNK;
-                    for k in 0..uc.len() {
-                        for d in 0..3 {
-                            let du = dt * v[n0 + k][d];
-                            uc[k][d] += du;
-                            duc[k][d] = du;
-                        }
-                    }
-                });
-        }
-        std::mem::swap(&mut self.f_damp_prev, &mut self.f_damp);
         self.time = t + dt;
         self.steps += 1;
     }
