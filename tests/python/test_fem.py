@@ -31,7 +31,9 @@ def test_explicit_damped_tends_to_static_and_errors(tmp_path):
     s = c.FemTetSolver(nodes, tets, 45e9, 0.2, 2230.0, rayleigh_alpha=2e6)
     s.set_prescribed(fixed, np.zeros(len(fixed)))
     s.set_loads(loads)
-    s.run(3000)
+    seen = []
+    s.run(3000, chunk=1000, progress=lambda n, t: seen.append((n, t)))
+    assert [n for n, _ in seen] == [1000, 2000, 3000]
     # Heavily damped: the axial displacement settles on the static solve (0.1 %).
     top_u = s.displacement()[top, 2].mean()
     assert top_u == pytest.approx(u_static[top, 2].mean(), rel=1e-3)

@@ -281,10 +281,11 @@ impl FemTetSolver {
         Ok(self.inner.set_initial_displacement(&u).map_err(PyDemfemError::from)?)
     }
 
-    /// Advance `n_steps` with the GIL released, in chunks of `chunk` steps; Ctrl-C between
-    /// chunks stops cleanly with SimulationInterrupted.
-    #[pyo3(signature = (n_steps, chunk=1000))]
-    fn run(&mut self, py: Python<'_>, n_steps: u64, chunk: u64) -> PyResult<()> {
+    /// Advance `n_steps` with the GIL released, in chunks of `chunk` steps; after each
+    /// chunk `progress(steps, time_s)` is called if given, and Ctrl-C stops cleanly with
+    /// SimulationInterrupted (the state stays consistent at a step boundary).
+    #[pyo3(signature = (n_steps, chunk=1000, progress=None))]
+    fn run(&mut self, py: Python<'_>, n_steps: u64, chunk: u64, progress: Option<Bound<'_, PyAny>>) -> PyResult<()> {
         let chunk = chunk.max(1);
         let mut done = 0;
         while done < n_steps {
@@ -292,6 +293,9 @@ impl FemTetSolver {
             let inner = &mut self.inner;
             py.detach(|| inner.run(k)).map_err(PyDemfemError::from)?;
             done += k;
+            if let Some(cb) = &progress {
+                cb.call1((self.inner.steps(), self.inner.time()))?;
+            }
             if py.check_signals().is_err() {
                 return Err(PyDemfemError::from(DemfemError::Interrupted { time: self.inner.time(), steps: self.inner.steps() }).into());
             }
