@@ -54,8 +54,10 @@ fn sliver_and_bad_input_are_refused() {
     mesh.validate().unwrap();
     assert!(matches!(mesh.check_quality(5.0), Err(DemfemError::InvalidParameter { .. })));
     // Inverted element.
-    let inv = TetMesh { nodes: mesh.nodes.clone(), tets: vec![[0, 2, 1, 3]] };
+    let mut inv = TetMesh { nodes: mesh.nodes.clone(), tets: vec![[0, 2, 1, 3]] };
     assert!(inv.validate().is_err());
+    assert_eq!(inv.orient(), 1);
+    inv.validate().unwrap();
     // Profiles: r_out <= r_in, decreasing z, mismatched lengths.
     assert!(AxisymmetricProfile::new(vec![0.0, 1.0], vec![2.0, 2.0], vec![1.0, 3.0]).is_err());
     assert!(AxisymmetricProfile::new(vec![1.0, 0.0], vec![1.0, 1.0], vec![2.0, 2.0]).is_err());

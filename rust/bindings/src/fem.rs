@@ -41,7 +41,9 @@ fn to_mesh(nodes: &PyReadonlyArray2<'_, f64>, tets: &PyReadonlyArray2<'_, i64>) 
         }
         out.push([r[0] as usize, r[1] as usize, r[2] as usize, r[3] as usize]);
     }
-    let mesh = TetMesh { nodes, tets: out };
+    let mut mesh = TetMesh { nodes, tets: out };
+    // Accept either orientation (gmsh and others differ); degenerate tets still fail.
+    mesh.orient();
     mesh.validate().map_err(PyDemfemError::from)?;
     Ok(mesh)
 }

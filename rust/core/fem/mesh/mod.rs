@@ -96,6 +96,23 @@ impl TetMesh {
         Ok(())
     }
 
+    /// Make every element positively oriented by swapping its last two nodes where the
+    /// signed volume is negative (meshes from other tools use either orientation).
+    /// Returns the number of elements flipped. Degenerate elements are left for
+    /// [`TetMesh::validate`] to reject.
+    pub fn orient(&mut self) -> usize {
+        let mut flipped = 0;
+        for t in self.tets.iter_mut() {
+            if t.iter().all(|&i| i < self.nodes.len())
+                && signed_volume(self.nodes[t[0]], self.nodes[t[1]], self.nodes[t[2]], self.nodes[t[3]]) < 0.0
+            {
+                t.swap(2, 3);
+                flipped += 1;
+            }
+        }
+        flipped
+    }
+
     /// Number of nodes.
     pub fn n_nodes(&self) -> usize {
         self.nodes.len()
