@@ -1,6 +1,8 @@
 """Hand-written stubs of the compiled core (checked by ``mypy.stubtest``). SI units."""
 from __future__ import annotations
 
+import os
+from collections.abc import Callable
 from os import PathLike
 from typing import Any, Optional, Sequence, final
 
@@ -10,13 +12,19 @@ import numpy.typing as npt
 __version__: str
 __all__ = [
     "DemSimulation",
-    "__version__",
+    "FemTetSolver",
+    "fem_element_stresses",
+    "fem_shell_mesh",
+    "fem_solve_static",
+    "fem_stress_invariants",
+    "fem_tet_mesh",
     "hertz_contact_duration",
     "max_impact_force",
     "normal_force",
     "rayleigh_time_step",
     "tsuji_damping_for_restitution",
     "tsuji_restitution",
+    "__version__",
 ]
 
 def normal_force(
@@ -155,3 +163,99 @@ class DemSimulation:
     def clear_records(self) -> None: ...
     def save_checkpoint(self, path: str | PathLike[str]) -> None: ...
     def load_checkpoint(self, path: str | PathLike[str]) -> None: ...
+
+def fem_tet_mesh(
+    z: npt.NDArray[np.float64],
+    r_in: npt.NDArray[np.float64],
+    r_out: npt.NDArray[np.float64],
+    n_theta: int,
+    n_layers: int,
+    target_size: float,
+    min_dihedral_deg: float = 5.0,
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int64], dict[str, float]]:
+    """Revolved linear-tet mesh of the axisymmetric body (stations z, radii in m):
+    (nodes (N,3) m, tets (E,4), quality dict). Slivers below min_dihedral_deg are refused."""
+
+def fem_shell_mesh(
+    z: npt.NDArray[np.float64],
+    r_in: npt.NDArray[np.float64],
+    r_out: npt.NDArray[np.float64],
+    n_theta: int,
+    target_size: float,
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int64], npt.NDArray[np.float64]]:
+    """Mid-surface triangle mesh: (nodes (N,3) m, triangles (T,3), thickness (T,) m)."""
+
+def fem_solve_static(
+    nodes: npt.NDArray[np.float64],
+    tets: npt.NDArray[np.int64],
+    youngs_modulus: float,
+    poisson_ratio: float,
+    loads: npt.NDArray[np.float64],
+    fixed_dofs: npt.NDArray[np.int64],
+    fixed_values: npt.NDArray[np.float64],
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """Sparse Cholesky solve K u = f: (u (N,3) m, reactions (N,3) N). E in Pa."""
+
+def fem_element_stresses(
+    nodes: npt.NDArray[np.float64],
+    tets: npt.NDArray[np.int64],
+    youngs_modulus: float,
+    poisson_ratio: float,
+    u: npt.NDArray[np.float64],
+) -> npt.NDArray[np.float64]:
+    """Element stresses (E,6) Pa in the order xx, yy, zz, yz, xz, xy."""
+
+def fem_stress_invariants(
+    s: npt.NDArray[np.float64],
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """Principal stresses (M,3) Pa (σ1 ≥ σ2 ≥ σ3) and von Mises stress (M,) Pa."""
+
+@final
+class FemTetSolver:
+    """Explicit central-difference solver for linear tets (SI units)."""
+
+    def __new__(
+        cls,
+        nodes: npt.NDArray[np.float64],
+        tets: npt.NDArray[np.int64],
+        youngs_modulus: float,
+        poisson_ratio: float,
+        density: float,
+        dt: float | None = None,
+        safety_factor: float = 0.9,
+        rayleigh_alpha: float = 0.0,
+        rayleigh_beta: float = 0.0,
+        mass_scaling_dt: float | None = None,
+        certified_step: bool = True,
+        energy_interval: int = 100,
+    ) -> FemTetSolver: ...
+    def set_prescribed(
+        self,
+        dofs: npt.NDArray[np.int64],
+        values: npt.NDArray[np.float64],
+        kind: str = "displacement",
+        rise_time: float = 0.0,
+    ) -> None: ...
+    def set_loads(self, loads: npt.NDArray[np.float64], rise_time: float = 0.0) -> None: ...
+    def set_extra_loads(self, loads: npt.NDArray[np.float64]) -> None: ...
+    def set_initial_velocity(self, v: npt.NDArray[np.float64]) -> None: ...
+    def set_initial_displacement(self, u: npt.NDArray[np.float64]) -> None: ...
+    def run(
+        self, n_steps: int, chunk: int = 1000, progress: Callable[[int, float], object] | None = None
+    ) -> None: ...
+    @property
+    def dt(self) -> float: ...
+    @property
+    def dt_limit(self) -> float: ...
+    @property
+    def time(self) -> float: ...
+    @property
+    def steps(self) -> int: ...
+    @property
+    def added_mass(self) -> float: ...
+    def displacement(self) -> npt.NDArray[np.float64]: ...
+    def velocity(self) -> npt.NDArray[np.float64]: ...
+    def energy(self) -> dict[str, float]: ...
+    def element_stresses(self) -> npt.NDArray[np.float64]: ...
+    def nodal_stresses(self) -> npt.NDArray[np.float64]: ...
+    def write_vtu(self, path: str | os.PathLike[str]) -> None: ...

@@ -254,7 +254,7 @@ def from_scene(
         np.ascontiguousarray(scene.radii, dtype=float),
         materials, walls, list(scene.effects),
         tags=np.asarray(scene.tags, dtype=np.int64),
-        gravity=tuple(float(g) for g in scene.gravity),
+        gravity=(float(scene.gravity[0]), float(scene.gravity[1]), float(scene.gravity[2])),
         model=model, dt=dt, dt_safety=dt_safety, expected_max_speed=expected_max_speed,
         threads=threads, record_every=record_every, record_onsets=record_onsets,
         removal_plane=removal_plane,

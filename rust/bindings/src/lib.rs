@@ -10,6 +10,7 @@ use demfem::contact::{self, ForceClamp, NormalLaw};
 use demfem::DemfemError;
 
 mod dem;
+mod fem;
 
 /// The one conversion from core errors to Python exceptions: each variant raises the class
 /// of the same name from `demfem.errors` (pure Python, so that bad input is both a
@@ -156,5 +157,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(rayleigh_time_step, m)?)?;
     m.add_function(wrap_pyfunction!(hertz_contact_duration, m)?)?;
     dem::register(m)?;
+    fem::register(m)?;
     Ok(())
 }

@@ -1,0 +1,401 @@
+//! Python bindings of the explicit FEM core: cartridge meshes as numpy arrays, the explicit
+//! tetrahedral solver (runs with the GIL released, in chunks so Ctrl-C is honoured), the
+//! sparse static solve and stress recovery. SI units throughout.
+
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use demfem::fem::io::vtk::{write_vtu, DataArray};
+use demfem::fem::stable_step::StepBound;
+use demfem::fem::{stress, AxisymmetricProfile, ExplicitConfig, ExplicitSolver, LinearElastic, LoadHistory, Prescribed, PrescribedKind, TetMesh};
+use demfem::DemfemError;
+
+use crate::PyDemfemError;
+
+type Nodes<'py> = Bound<'py, PyArray2<f64>>;
+
+fn shape_err(field: &str, detail: String) -> PyErr {
+    PyDemfemError::from(DemfemError::ShapeMismatch { field: field.into(), detail }).into()
+}
+
+fn rows3(a: &PyReadonlyArray2<'_, f64>, field: &str) -> PyResult<Vec<[f64; 3]>> {
+    let v = a.as_array();
+    if v.ncols() != 3 {
+        return Err(shape_err(field, format!("expected shape (n, 3), got {:?}", v.shape())));
+    }
+    Ok(v.rows().into_iter().map(|r| [r[0], r[1], r[2]]).collect())
+}
+
+fn to_mesh(nodes: &PyReadonlyArray2<'_, f64>, tets: &PyReadonlyArray2<'_, i64>) -> PyResult<TetMesh> {
+    let nodes = rows3(nodes, "nodes")?;
+    let t = tets.as_array();
+    if t.ncols() != 4 {
+        return Err(shape_err("tets", format!("expected shape (n, 4), got {:?}", t.shape())));
+    }
+    let mut out = Vec::with_capacity(t.nrows());
+    for r in t.rows() {
+        if r.iter().any(|&i| i < 0) {
+            return Err(shape_err("tets", "negative node index".into()));
+        }
+        out.push([r[0] as usize, r[1] as usize, r[2] as usize, r[3] as usize]);
+    }
+    let mut mesh = TetMesh { nodes, tets: out };
+    // Accept either orientation (gmsh and others differ); degenerate tets still fail.
+    mesh.orient();
+    mesh.validate().map_err(PyDemfemError::from)?;
+    Ok(mesh)
+}
+
+fn arr3<'py>(py: Python<'py>, v: &[[f64; 3]]) -> PyResult<Nodes<'py>> {
+    let flat: Vec<f64> = v.iter().flatten().cloned().collect();
+    let a = Array2::from_shape_vec((v.len(), 3), flat).map_err(|e| shape_err("array", e.to_string()))?;
+    Ok(a.into_pyarray(py))
+}
+
+fn arr6<'py>(py: Python<'py>, v: &[[f64; 6]]) -> PyResult<Nodes<'py>> {
+    let flat: Vec<f64> = v.iter().flatten().cloned().collect();
+    let a = Array2::from_shape_vec((v.len(), 6), flat).map_err(|e| shape_err("array", e.to_string()))?;
+    Ok(a.into_pyarray(py))
+}
+
+fn idx_arr<'py, const K: usize>(py: Python<'py>, v: &[[usize; K]]) -> PyResult<Bound<'py, PyArray2<i64>>> {
+    let flat: Vec<i64> = v.iter().flatten().map(|&i| i as i64).collect();
+    let a = Array2::from_shape_vec((v.len(), K), flat).map_err(|e| shape_err("array", e.to_string()))?;
+    Ok(a.into_pyarray(py))
+}
+
+fn profile(z: PyReadonlyArray1<'_, f64>, r_in: PyReadonlyArray1<'_, f64>, r_out: PyReadonlyArray1<'_, f64>) -> PyResult<AxisymmetricProfile> {
+    Ok(AxisymmetricProfile::new(z.as_array().to_vec(), r_in.as_array().to_vec(), r_out.as_array().to_vec()).map_err(PyDemfemError::from)?)
+}
+
+/// Revolved linear-tetrahedron mesh of an axisymmetric body (stations z, radii r_in,
+/// r_out in m). Returns (nodes (N,3) m, tets (E,4) int64, quality dict).
+#[pyfunction]
+#[pyo3(signature = (z, r_in, r_out, n_theta, n_layers, target_size, min_dihedral_deg=5.0))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+fn fem_tet_mesh<'py>(
+    py: Python<'py>,
+    z: PyReadonlyArray1<'py, f64>,
+    r_in: PyReadonlyArray1<'py, f64>,
+    r_out: PyReadonlyArray1<'py, f64>,
+    n_theta: usize,
+    n_layers: usize,
+    target_size: f64,
+    min_dihedral_deg: f64,
+) -> PyResult<(Nodes<'py>, Bound<'py, PyArray2<i64>>, Bound<'py, PyDict>)> {
+    let p = profile(z, r_in, r_out)?;
+    let rm = py.detach(|| p.tet_mesh(n_theta, n_layers, target_size)).map_err(PyDemfemError::from)?;
+    let q = rm.mesh.check_quality(min_dihedral_deg).map_err(PyDemfemError::from)?;
+    let d = PyDict::new(py);
+    d.set_item("min_dihedral_deg", q.min_dihedral_deg)?;
+    d.set_item("max_dihedral_deg", q.max_dihedral_deg)?;
+    d.set_item("max_aspect_ratio", q.max_aspect_ratio)?;
+    d.set_item("mean_aspect_ratio", q.mean_aspect_ratio)?;
+    d.set_item("min_volume", q.min_volume)?;
+    d.set_item("n_elements", q.n_elements)?;
+    Ok((arr3(py, &rm.mesh.nodes)?, idx_arr(py, &rm.mesh.tets)?, d))
+}
+
+/// Mid-surface triangle shell mesh. Returns (nodes (N,3) m, triangles (T,3) int64,
+/// thickness (T,) m).
+#[pyfunction]
+#[allow(clippy::type_complexity)]
+fn fem_shell_mesh<'py>(
+    py: Python<'py>,
+    z: PyReadonlyArray1<'py, f64>,
+    r_in: PyReadonlyArray1<'py, f64>,
+    r_out: PyReadonlyArray1<'py, f64>,
+    n_theta: usize,
+    target_size: f64,
+) -> PyResult<(Nodes<'py>, Bound<'py, PyArray2<i64>>, Bound<'py, PyArray1<f64>>)> {
+    let p = profile(z, r_in, r_out)?;
+    let m = p.shell_mesh(n_theta, target_size).map_err(PyDemfemError::from)?;
+    Ok((arr3(py, &m.nodes)?, idx_arr(py, &m.triangles)?, m.thickness.into_pyarray(py)))
+}
+
+fn prescribed_list(dofs: &PyReadonlyArray2<'_, i64>, values: &PyReadonlyArray1<'_, f64>) -> PyResult<Vec<(usize, usize, f64)>> {
+    let d = dofs.as_array();
+    let v = values.as_array();
+    if d.ncols() != 2 || d.nrows() != v.len() {
+        return Err(shape_err("fixed_dofs", format!("expected (k, 2) node/component pairs and k values, got {:?} and {}", d.shape(), v.len())));
+    }
+    d.rows()
+        .into_iter()
+        .zip(v.iter())
+        .map(|(r, &x)| {
+            if r[0] < 0 || !(0..3).contains(&r[1]) {
+                Err(shape_err("fixed_dofs", format!("bad pair ({}, {})", r[0], r[1])))
+            } else {
+                Ok((r[0] as usize, r[1] as usize, x))
+            }
+        })
+        .collect()
+}
+
+/// Linear static solve K u = f. `fixed_dofs` (k,2): node, component; `fixed_values` (k,) m.
+/// Returns (u (N,3) m, reactions (N,3) N).
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+fn fem_solve_static<'py>(
+    py: Python<'py>,
+    nodes: PyReadonlyArray2<'py, f64>,
+    tets: PyReadonlyArray2<'py, i64>,
+    youngs_modulus: f64,
+    poisson_ratio: f64,
+    loads: PyReadonlyArray2<'py, f64>,
+    fixed_dofs: PyReadonlyArray2<'py, i64>,
+    fixed_values: PyReadonlyArray1<'py, f64>,
+) -> PyResult<(Nodes<'py>, Nodes<'py>)> {
+    let mesh = to_mesh(&nodes, &tets)?;
+    let mat = LinearElastic::new(youngs_modulus, poisson_ratio, 1.0).map_err(PyDemfemError::from)?;
+    let f = rows3(&loads, "loads")?;
+    let fixed = prescribed_list(&fixed_dofs, &fixed_values)?;
+    let sol = py.detach(|| demfem::fem::static_solve::solve_static(&mesh, &mat, &f, &fixed)).map_err(PyDemfemError::from)?;
+    Ok((arr3(py, &sol.displacement)?, arr3(py, &sol.reaction)?))
+}
+
+/// Element stresses (E,6) Pa, order xx, yy, zz, yz, xz, xy, for displacements u (N,3) m.
+#[pyfunction]
+fn fem_element_stresses<'py>(
+    py: Python<'py>,
+    nodes: PyReadonlyArray2<'py, f64>,
+    tets: PyReadonlyArray2<'py, i64>,
+    youngs_modulus: f64,
+    poisson_ratio: f64,
+    u: PyReadonlyArray2<'py, f64>,
+) -> PyResult<Nodes<'py>> {
+    let mesh = to_mesh(&nodes, &tets)?;
+    let mat = LinearElastic::new(youngs_modulus, poisson_ratio, 1.0).map_err(PyDemfemError::from)?;
+    let u = rows3(&u, "u")?;
+    let s = stress::element_stresses(&mesh, &mat, &u).map_err(PyDemfemError::from)?;
+    arr6(py, &s)
+}
+
+/// Principal stresses (M,3) Pa, σ1 ≥ σ2 ≥ σ3, and von Mises (M,) Pa of stresses (M,6).
+#[pyfunction]
+fn fem_stress_invariants<'py>(py: Python<'py>, s: PyReadonlyArray2<'py, f64>) -> PyResult<(Nodes<'py>, Bound<'py, PyArray1<f64>>)> {
+    let a = s.as_array();
+    if a.ncols() != 6 {
+        return Err(shape_err("stress", format!("expected shape (m, 6), got {:?}", a.shape())));
+    }
+    let mut p = Vec::with_capacity(a.nrows());
+    let mut vm = Vec::with_capacity(a.nrows());
+    for r in a.rows() {
+        let t = [r[0], r[1], r[2], r[3], r[4], r[5]];
+        p.push(stress::principal_stresses(&t));
+        vm.push(stress::von_mises(&t));
+    }
+    Ok((arr3(py, &p)?, vm.into_pyarray(py)))
+}
+
+/// Explicit central-difference solver for linear tetrahedra (lumped mass, Rayleigh
+/// damping, certified stable step). Times in s, lengths in m, forces in N.
+#[pyclass(module = "demfem._core")]
+struct FemTetSolver {
+    inner: ExplicitSolver,
+    mesh: TetMesh,
+    material: LinearElastic,
+}
+
+#[pymethods]
+impl FemTetSolver {
+    #[new]
+    #[pyo3(signature = (nodes, tets, youngs_modulus, poisson_ratio, density, dt=None, safety_factor=0.9, rayleigh_alpha=0.0, rayleigh_beta=0.0, mass_scaling_dt=None, certified_step=true, energy_interval=100))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        py: Python<'_>,
+        nodes: PyReadonlyArray2<'_, f64>,
+        tets: PyReadonlyArray2<'_, i64>,
+        youngs_modulus: f64,
+        poisson_ratio: f64,
+        density: f64,
+        dt: Option<f64>,
+        safety_factor: f64,
+        rayleigh_alpha: f64,
+        rayleigh_beta: f64,
+        mass_scaling_dt: Option<f64>,
+        certified_step: bool,
+        energy_interval: usize,
+    ) -> PyResult<Self> {
+        let mesh = to_mesh(&nodes, &tets)?;
+        let material = LinearElastic::new(youngs_modulus, poisson_ratio, density).map_err(PyDemfemError::from)?;
+        let mut cfg = ExplicitConfig::new(material);
+        cfg.dt = dt;
+        cfg.safety_factor = safety_factor;
+        cfg.rayleigh_alpha = rayleigh_alpha;
+        cfg.rayleigh_beta = rayleigh_beta;
+        cfg.mass_scaling_dt = mass_scaling_dt;
+        cfg.energy_interval = energy_interval;
+        if !certified_step {
+            cfg.step_bound = StepBound::ElementEigenvalue;
+        }
+        let inner = py.detach(|| ExplicitSolver::new(&mesh, cfg)).map_err(PyDemfemError::from)?;
+        Ok(Self { inner, mesh, material })
+    }
+
+    /// Prescribe dofs: `dofs` (k,2) node/component, `values` (k,), `kind` 'displacement'
+    /// (m, scaled by a linear ramp over `rise_time` s if > 0) or 'velocity' (m/s).
+    #[pyo3(signature = (dofs, values, kind="displacement", rise_time=0.0))]
+    fn set_prescribed(&mut self, dofs: PyReadonlyArray2<'_, i64>, values: PyReadonlyArray1<'_, f64>, kind: &str, rise_time: f64) -> PyResult<()> {
+        let list = prescribed_list(&dofs, &values)?;
+        let mk: fn(f64) -> PrescribedKind = match kind {
+            "displacement" => PrescribedKind::Displacement,
+            "velocity" => PrescribedKind::Velocity,
+            other => {
+                return Err(PyDemfemError::from(DemfemError::InvalidParameter {
+                    field: "kind".into(),
+                    value: other.into(),
+                    allowed: "'displacement' or 'velocity'".into(),
+                })
+                .into())
+            }
+        };
+        let p: Vec<Prescribed> = list.into_iter().map(|(node, component, v)| Prescribed { node, component, kind: mk(v) }).collect();
+        let h = if rise_time > 0.0 { LoadHistory::Ramp { rise_time } } else { LoadHistory::Constant };
+        Ok(self.inner.set_prescribed(&p, h).map_err(PyDemfemError::from)?)
+    }
+
+    /// Nodal loads (N,3) N, applied suddenly or with a smooth ramp over `rise_time` s.
+    #[pyo3(signature = (loads, rise_time=0.0))]
+    fn set_loads(&mut self, loads: PyReadonlyArray2<'_, f64>, rise_time: f64) -> PyResult<()> {
+        let f = rows3(&loads, "loads")?;
+        let h = if rise_time > 0.0 { LoadHistory::SmoothRamp { rise_time } } else { LoadHistory::Constant };
+        Ok(self.inner.set_loads(f, h).map_err(PyDemfemError::from)?)
+    }
+
+    /// Extra nodal forces (N,3) N held until changed (e.g. contact forces).
+    fn set_extra_loads(&mut self, loads: PyReadonlyArray2<'_, f64>) -> PyResult<()> {
+        let f = rows3(&loads, "extra_loads")?;
+        Ok(self.inner.set_extra_loads(&f).map_err(PyDemfemError::from)?)
+    }
+
+    /// Initial velocity (N,3) m/s (before the first step).
+    fn set_initial_velocity(&mut self, v: PyReadonlyArray2<'_, f64>) -> PyResult<()> {
+        let v = rows3(&v, "velocity")?;
+        Ok(self.inner.set_initial_velocity(&v).map_err(PyDemfemError::from)?)
+    }
+
+    /// Initial displacement (N,3) m (before the first step).
+    fn set_initial_displacement(&mut self, u: PyReadonlyArray2<'_, f64>) -> PyResult<()> {
+        let u = rows3(&u, "displacement")?;
+        Ok(self.inner.set_initial_displacement(&u).map_err(PyDemfemError::from)?)
+    }
+
+    /// Advance `n_steps` with the GIL released, in chunks of `chunk` steps; after each
+    /// chunk `progress(steps, time_s)` is called if given, and Ctrl-C stops cleanly with
+    /// SimulationInterrupted (the state stays consistent at a step boundary).
+    #[pyo3(signature = (n_steps, chunk=1000, progress=None))]
+    fn run(&mut self, py: Python<'_>, n_steps: u64, chunk: u64, progress: Option<Bound<'_, PyAny>>) -> PyResult<()> {
+        let chunk = chunk.max(1);
+        let mut done = 0;
+        while done < n_steps {
+            let k = chunk.min(n_steps - done);
+            let inner = &mut self.inner;
+            py.detach(|| inner.run(k)).map_err(PyDemfemError::from)?;
+            done += k;
+            if let Some(cb) = &progress {
+                cb.call1((self.inner.steps(), self.inner.time()))?;
+            }
+            if py.check_signals().is_err() {
+                return Err(PyDemfemError::from(DemfemError::Interrupted { time: self.inner.time(), steps: self.inner.steps() }).into());
+            }
+        }
+        Ok(())
+    }
+
+    /// Time step in use, s.
+    #[getter]
+    fn dt(&self) -> f64 {
+        self.inner.dt()
+    }
+    /// Proven stable-step bound, s.
+    #[getter]
+    fn dt_limit(&self) -> f64 {
+        self.inner.dt_limit()
+    }
+    /// Current time, s.
+    #[getter]
+    fn time(&self) -> f64 {
+        self.inner.time()
+    }
+    /// Steps taken.
+    #[getter]
+    fn steps(&self) -> u64 {
+        self.inner.steps()
+    }
+    /// Mass added by mass scaling, kg.
+    #[getter]
+    fn added_mass(&self) -> f64 {
+        self.inner.added_mass()
+    }
+    /// Displacement (N,3), m.
+    fn displacement<'py>(&self, py: Python<'py>) -> PyResult<Nodes<'py>> {
+        arr3(py, self.inner.displacement())
+    }
+    /// Velocity at the last half step (N,3), m/s.
+    fn velocity<'py>(&self, py: Python<'py>) -> PyResult<Nodes<'py>> {
+        arr3(py, self.inner.velocity())
+    }
+    /// Energies (J) at the start of the last step: time, kinetic, internal, external_work,
+    /// damping_work, initial, relative_balance_error.
+    fn energy<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let e = self.inner.energy();
+        let d = PyDict::new(py);
+        d.set_item("time", e.time)?;
+        d.set_item("kinetic", e.kinetic)?;
+        d.set_item("internal", e.internal)?;
+        d.set_item("external_work", e.external_work)?;
+        d.set_item("damping_work", e.damping_work)?;
+        d.set_item("initial", e.initial)?;
+        d.set_item("relative_balance_error", e.relative_balance_error())?;
+        Ok(d)
+    }
+    /// Element stresses (E,6) Pa, order xx, yy, zz, yz, xz, xy.
+    fn element_stresses<'py>(&self, py: Python<'py>) -> PyResult<Nodes<'py>> {
+        let s = stress::element_stresses(&self.mesh, &self.material, self.inner.displacement()).map_err(PyDemfemError::from)?;
+        arr6(py, &s)
+    }
+    /// Nodal (volume-averaged) stresses (N,6) Pa.
+    fn nodal_stresses<'py>(&self, py: Python<'py>) -> PyResult<Nodes<'py>> {
+        let s = stress::element_stresses(&self.mesh, &self.material, self.inner.displacement()).map_err(PyDemfemError::from)?;
+        let n = stress::nodal_stresses(&self.mesh, &s).map_err(PyDemfemError::from)?;
+        arr6(py, &n)
+    }
+    /// Write the current state to a .vtu file (displacement, velocity, nodal stress, σ1).
+    fn write_vtu(&self, path: std::path::PathBuf) -> PyResult<()> {
+        let u: Vec<f64> = self.inner.displacement().iter().flatten().cloned().collect();
+        let v: Vec<f64> = self.inner.velocity().iter().flatten().cloned().collect();
+        let es = stress::element_stresses(&self.mesh, &self.material, self.inner.displacement()).map_err(PyDemfemError::from)?;
+        let ns = stress::nodal_stresses(&self.mesh, &es).map_err(PyDemfemError::from)?;
+        let s1: Vec<f64> = ns.iter().map(stress::max_principal_stress).collect();
+        let s1e: Vec<f64> = es.iter().map(stress::max_principal_stress).collect();
+        let nsf: Vec<f64> = ns.iter().flatten().cloned().collect();
+        write_vtu(
+            &path,
+            &self.mesh.nodes,
+            &self.mesh.tets,
+            &[
+                DataArray { name: "displacement", n_components: 3, values: &u },
+                DataArray { name: "velocity", n_components: 3, values: &v },
+                DataArray { name: "stress", n_components: 6, values: &nsf },
+                DataArray { name: "sigma1", n_components: 1, values: &s1 },
+            ],
+            &[DataArray { name: "sigma1_element", n_components: 1, values: &s1e }],
+        )
+        .map_err(PyDemfemError::from)?;
+        Ok(())
+    }
+}
+
+/// Register the FEM functions and classes on the extension module.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(fem_tet_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(fem_shell_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(fem_solve_static, m)?)?;
+    m.add_function(wrap_pyfunction!(fem_element_stresses, m)?)?;
+    m.add_function(wrap_pyfunction!(fem_stress_invariants, m)?)?;
+    m.add_class::<FemTetSolver>()?;
+    Ok(())
+}
