@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from demfem import _core as c
-from demfem.errors import UnstableTimeStepError
+from demfem.errors import InvalidParameterError, ShapeError, UnstableTimeStepError
 
 MM = 1e-3
 Z = np.array([0, 54.5, 58.5, 61.0, 61.3, 64.0]) * MM
@@ -43,9 +43,9 @@ def test_explicit_damped_tends_to_static_and_errors(tmp_path):
     assert (tmp_path / "state.vtu").read_text().rstrip().endswith("</VTKFile>")
     with pytest.raises(UnstableTimeStepError):
         c.FemTetSolver(nodes, tets, 45e9, 0.2, 2230.0, dt=1e-3)
-    with pytest.raises(c.ShapeError):
+    with pytest.raises(ShapeError):
         c.FemTetSolver(nodes, tets[:, :3], 45e9, 0.2, 2230.0)
-    with pytest.raises(c.InvalidParameterError):
+    with pytest.raises(InvalidParameterError):
         c.FemTetSolver(nodes, tets, 45e9, 0.7, 2230.0)
     p, vm = c.fem_stress_invariants(np.array([[100.0, 0, 0, 0, 0, 0]]))
     assert p[0, 0] == pytest.approx(100.0) and vm[0] == pytest.approx(100.0)
