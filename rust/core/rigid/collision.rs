@@ -190,8 +190,8 @@ pub fn clump_clump_contacts(
     let rot_ab: Matrix3<f64> =
         (pose_a.orientation.inverse() * pose_b.orientation).to_rotation_matrix().into_inner();
     let t = rot_a.transpose() * between; // b's origin in a's frame
-    let inside = |p: &Vector3<f64>, half: &Vector3<f64>, pad: f64| {
-        p.x.abs() <= half.x + pad && p.y.abs() <= half.y + pad && p.z.abs() <= half.z + pad
+    let inside = |p: &Vector3<f64>, clump: &BeadClump, pad: f64| {
+        (0..3).all(|k| p[k] >= clump.aabb_min[k] - pad && p[k] <= clump.aabb_max[k] + pad)
     };
     scratch.first.clear();
     scratch.second.clear();
@@ -199,7 +199,7 @@ pub fn clump_clump_contacts(
     let mut hi = Vector3::repeat(f64::NEG_INFINITY);
     for (j, c) in b.centers.iter().enumerate() {
         let in_a = t + rot_ab * c;
-        if inside(&in_a, &a.half_extents, b.radii[j]) {
+        if inside(&in_a, a, b.radii[j]) {
             lo = lo.inf(&in_a);
             hi = hi.sup(&in_a);
             scratch.second.push((0.0, j as u32, in_a));
@@ -210,7 +210,7 @@ pub fn clump_clump_contacts(
     }
     for (i, c) in a.centers.iter().enumerate() {
         let in_b = rot_ab.transpose() * (c - t);
-        if inside(&in_b, &b.half_extents, a.radii[i]) {
+        if inside(&in_b, b, a.radii[i]) {
             scratch.first.push((i as u32, *c));
         }
     }
@@ -265,6 +265,10 @@ impl std::fmt::Debug for ExactContactCache {
     }
 }
 
+/// Contacts of different pieces closer than this angle times the piece radius (one edge of
+/// the 32-gon of a cone piece) are one contact, rad.
+const HULL_EDGE_ANGLE: f64 = 2.0 * std::f64::consts::PI / 32.0;
+
 /// Radius of the piece `id` of an exact shape; `inf` for a plane, the ball's own for a ball.
 type RadiusOf<'a> = &'a dyn Fn(u32) -> f64;
 
@@ -283,6 +287,7 @@ fn manifold_contacts(
     DefaultQueryDispatcher
         .contact_manifolds(&pos12, shape1, shape2, 0.0, &mut cache.manifolds, &mut cache.workspace)
         .map_err(|_| DemfemError::Effect("parry3d has no contact manifold for this shape pair".into()))?;
+    let first_new = out.len();
     for manifold in &cache.manifolds {
         let sub1 = manifold.subshape_pos1().copied().unwrap_or(Pose::IDENTITY);
         let sub2 = manifold.subshape_pos2().copied().unwrap_or(Pose::IDENTITY);
@@ -295,8 +300,35 @@ fn manifold_contacts(
             }
             let p1 = to_nalgebra(frame1 * contact.local_p1);
             let p2 = to_nalgebra(frame2 * contact.local_p2);
+            let point = 0.5 * (p1 + p2);
+            // Adjacent pieces of a compound share their boundary circle (body cylinder and
+            // shoulder cone): both report the same physical contact there, up to one edge of
+            // the cone's polygon. Count it once, keeping the deeper report.
+            let (r1, r2) = (radius1(manifold.subshape1), radius2(manifold.subshape2));
+            let overlap = -contact.dist;
+            let reach = HULL_EDGE_ANGLE * [r1, r2].into_iter().filter(|r| r.is_finite()).fold(0.0, f64::max);
+            let same_contact = out[first_new..].iter().position(|c| {
+                (c.feature_first != manifold.subshape1 || c.feature_second != manifold.subshape2)
+                    && (c.point - point).norm() < reach
+                    && c.normal.dot(&normal) > 0.999
+            });
+            if let Some(k) = same_contact {
+                let existing = &mut out[first_new + k];
+                if overlap > existing.overlap * (1.0 + 1e-9) {
+                    *existing = ContactPoint {
+                        point,
+                        normal,
+                        overlap,
+                        radius_first: r1,
+                        radius_second: r2,
+                        feature_first: manifold.subshape1,
+                        feature_second: manifold.subshape2,
+                    };
+                }
+                continue;
+            }
             out.push(ContactPoint {
-                point: 0.5 * (p1 + p2),
+                point,
                 normal,
                 overlap: -contact.dist,
                 radius_first: radius1(manifold.subshape1),

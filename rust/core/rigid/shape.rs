@@ -142,8 +142,10 @@ pub struct BeadClump {
     pub max_bead_radius: f64,
     /// Smallest bead radius, m.
     pub min_bead_radius: f64,
-    /// Half-extents of the body-frame box around all beads (centred at the origin), m.
-    pub half_extents: Vector3<f64>,
+    /// Lower corner of the body-frame box around all beads, m.
+    pub aabb_min: Vector3<f64>,
+    /// Upper corner of the body-frame box around all beads, m.
+    pub aabb_max: Vector3<f64>,
     /// Rotation from the body (principal) frame to the frame the beads were given in.
     pub principal_frame: UnitQuaternion<f64>,
 }
@@ -218,12 +220,12 @@ impl BeadClump {
         principal_frame: UnitQuaternion<f64>,
     ) -> Self {
         let mut bounding_radius: f64 = 0.0;
-        let mut half_extents = Vector3::zeros();
+        let mut aabb_min = Vector3::repeat(f64::INFINITY);
+        let mut aabb_max = Vector3::repeat(f64::NEG_INFINITY);
         for (c, &r) in centers.iter().zip(&radii) {
             bounding_radius = bounding_radius.max(c.norm() + r);
-            for k in 0..3 {
-                half_extents[k] = f64::max(half_extents[k], c[k].abs() + r);
-            }
+            aabb_min = aabb_min.inf(&c.add_scalar(-r));
+            aabb_max = aabb_max.sup(&c.add_scalar(r));
         }
         let max_bead_radius = radii.iter().cloned().fold(0.0, f64::max);
         let min_bead_radius = radii.iter().cloned().fold(f64::INFINITY, f64::min);
@@ -233,7 +235,8 @@ impl BeadClump {
             bounding_radius,
             max_bead_radius,
             min_bead_radius,
-            half_extents,
+            aabb_min,
+            aabb_max,
             principal_frame,
         }
     }
