@@ -56,7 +56,7 @@ impl Plane {
         surface_velocity: Vector3<f64>,
     ) -> Result<Self> {
         let length = normal.norm();
-        if !(length > 0.0 && length.is_finite())
+        if length.is_nan() || length <= 0.0 || length.is_infinite()
             || !point.iter().chain(surface_velocity.iter()).all(|v| v.is_finite())
         {
             return Err(DemfemError::ShapeMismatch {

@@ -11,6 +11,12 @@
 //! (m_eff = 1/λ_max(𝟙/m + [r]×ᵀ I⁻¹ [r]×), the mass felt by a push at lever arm r), divided by
 //! [`STEPS_PER_CONTACT`]. A requested step above it is refused with
 //! [`DemfemError::UnstableTimeStep`].
+//!
+//! Damping of multi-point contacts. When n beads (or parry points) of one body pair touch at
+//! once, each carries the Tsuji damping of m*/n: n springs of similar stiffness k act as one
+//! spring nk on the mass m*, and ζ √(m* nk) = n · ζ √((m*/n) k). With the whole m* per point
+//! the pair would be √n times over-damped (a cartridge hitting a wall with its side touches
+//! with ~60 beads at once and would keep a restitution of ~0.15 instead of 0.5).
 
 use std::collections::HashMap;
 
@@ -306,15 +312,11 @@ impl RigidScene {
                     }
                 }
                 count += contacts.len();
+                let m_star = self.bodies.mass[i] / contacts.len().max(1) as f64;
                 for c in &contacts {
                     max_overlap = max_overlap.max(c.overlap);
                     let relative = self.bodies.point_velocity(i, &c.point) - plane.surface_velocity;
-                    let f = self.model.force(
-                        c,
-                        &relative,
-                        self.bodies.mass[i],
-                        self.model.e_star_body_plane,
-                    )?;
+                    let f = self.model.force(c, &relative, m_star, self.model.e_star_body_plane)?;
                     self.apply(i, &c.point, &f);
                 }
             }
@@ -353,7 +355,8 @@ impl RigidScene {
                     }
                 }
                 let (first, second) = if flipped { (b, a) } else { (a, b) };
-                let m_star = effective_mass(self.bodies.mass[first], self.bodies.mass[second])?;
+                let m_star = effective_mass(self.bodies.mass[first], self.bodies.mass[second])?
+                    / contacts.len().max(1) as f64;
                 count += contacts.len();
                 for c in &contacts {
                     max_overlap = max_overlap.max(c.overlap);

@@ -62,7 +62,7 @@ impl RevolutionProfile {
                 return Err(DemfemError::invalid("r_in", r_in[k], &format!("< r_out = {}", r_out[k])));
             }
         }
-        if !(z[z.len() - 1] > z[0]) {
+        if z[z.len() - 1] <= z[0] {
             return Err(DemfemError::invalid("z", z[z.len() - 1], "above the first station"));
         }
         Ok(Self { z, r_in, r_out })
