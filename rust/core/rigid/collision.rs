@@ -257,6 +257,8 @@ pub fn clump_clump_contacts(
 pub struct ExactContactCache {
     manifolds: Vec<ContactManifold<(), ()>>,
     workspace: Option<ContactManifoldsWorkspace>,
+    /// Force evaluation that last used this cache (the scene drops caches it did not use).
+    pub(crate) last_used: u64,
 }
 
 impl std::fmt::Debug for ExactContactCache {

@@ -28,7 +28,7 @@ use super::collision::{
     exact_plane_contacts, BodyPose, ClumpPairScratch, ContactPoint, ExactContactCache, Plane,
 };
 use super::forces::{ContactMaterial, ContactModel};
-use super::shape::{MassProperties, RigidShape};
+use super::shape::{BoundingCapsule, MassProperties, RigidShape};
 use crate::contact::{effective_mass, effective_radius, hertz_contact_duration, hertz_stiffness};
 use crate::error::{check_positive, DemfemError, Result};
 
@@ -99,6 +99,8 @@ pub struct RigidScene {
     contacts: Vec<ContactPoint>,
     clump_scratch: ClumpPairScratch,
     exact_caches: HashMap<(usize, usize), ExactContactCache>,
+    sweep_order: Vec<(f64, f64, usize)>,
+    evaluations: u64,
     contacts_last_step: usize,
     max_overlap_last_step: f64,
 }
@@ -138,6 +140,8 @@ impl RigidScene {
             contacts: Vec::new(),
             clump_scratch: ClumpPairScratch::default(),
             exact_caches: HashMap::new(),
+            sweep_order: Vec::new(),
+            evaluations: 0,
             contacts_last_step: 0,
             max_overlap_last_step: 0.0,
         })
@@ -290,6 +294,8 @@ impl RigidScene {
     /// Gravity and every contact force and torque of the current configuration.
     fn compute_forces(&mut self) -> Result<()> {
         self.bodies.clear_forces();
+        self.evaluations += 1;
+        let evaluation = self.evaluations;
         for i in 0..self.bodies.len() {
             self.bodies.force[i] = self.gravity * self.bodies.mass[i];
         }
@@ -308,6 +314,7 @@ impl RigidScene {
                     }
                     RigidShape::Exact(shape) => {
                         let cache = self.exact_caches.entry((i, usize::MAX - p)).or_default();
+                        cache.last_used = evaluation;
                         exact_plane_contacts(&plane, shape, &pose, cache, &mut contacts)?
                     }
                 }
@@ -321,13 +328,27 @@ impl RigidScene {
                 }
             }
         }
-        for a in 0..self.bodies.len() {
-            for b in (a + 1)..self.bodies.len() {
+        // broad phase: sort and sweep the bounding spheres along x (O(N log N) pairs)
+        let mut order = std::mem::take(&mut self.sweep_order);
+        order.clear();
+        for i in 0..self.bodies.len() {
+            let r = self.shapes[self.body_shape[i]].0.bounding_radius();
+            order.push((self.bodies.position[i].x - r, self.bodies.position[i].x + r, i));
+        }
+        order.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
+        for (k, &(_, upper, first_index)) in order.iter().enumerate() {
+            for &(lower, _, second_index) in &order[k + 1..] {
+                if lower >= upper {
+                    break;
+                }
+                let (a, b) = (first_index.min(second_index), first_index.max(second_index));
                 let (pa, pb) = (self.pose(a), self.pose(b));
-                let reach = self.shapes[self.body_shape[a]].0.bounding_radius()
-                    + self.shapes[self.body_shape[b]].0.bounding_radius();
-                if (pb.position - pa.position).norm() >= reach {
-                    self.exact_caches.remove(&(a, b));
+                let (shape_a, shape_b) =
+                    (&self.shapes[self.body_shape[a]].0, &self.shapes[self.body_shape[b]].0);
+                let reach = shape_a.bounding_radius() + shape_b.bounding_radius();
+                let apart = (pb.position - pa.position).norm() >= reach
+                    || !capsules_overlap(&shape_a.bounding_capsule(), &pa, &shape_b.bounding_capsule(), &pb);
+                if apart {
                     continue;
                 }
                 contacts.clear();
@@ -344,6 +365,7 @@ impl RigidScene {
                     ),
                     (RigidShape::Exact(ea), RigidShape::Exact(eb)) => {
                         let cache = self.exact_caches.entry((a, b)).or_default();
+                        cache.last_used = evaluation;
                         exact_exact_contacts(ea, &pa, eb, &pb, cache, &mut contacts)?
                     }
                     (RigidShape::Clump(ca), RigidShape::Exact(eb)) => {
@@ -368,7 +390,12 @@ impl RigidScene {
                 }
             }
         }
+        // manifolds of pairs that drifted apart are stale: forget them
+        if !self.exact_caches.is_empty() {
+            self.exact_caches.retain(|_, cache| cache.last_used == evaluation);
+        }
         self.contacts = contacts;
+        self.sweep_order = order;
         self.contacts_last_step = count;
         self.max_overlap_last_step = max_overlap;
         self.forces_current = true;
@@ -395,4 +422,77 @@ fn smallest_effective_mass(points: &[Vector3<f64>], mass: &MassProperties) -> f6
         }
     }
     smallest
+}
+
+/// True when the bounding capsules of two bodies overlap (a cheap, tight cull for long
+/// bodies: two upright cartridges 2 cm apart have overlapping bounding spheres, not capsules).
+fn capsules_overlap(a: &BoundingCapsule, pose_a: &BodyPose, b: &BoundingCapsule, pose_b: &BodyPose) -> bool {
+    let axis_a = pose_a.orientation * Vector3::z();
+    let axis_b = pose_b.orientation * Vector3::z();
+    let (a0, a1) = (pose_a.position + axis_a * a.z_min, pose_a.position + axis_a * a.z_max);
+    let (b0, b1) = (pose_b.position + axis_b * b.z_min, pose_b.position + axis_b * b.z_max);
+    let reach = a.radius + b.radius;
+    segment_distance_squared(&a0, &a1, &b0, &b1) < reach * reach
+}
+
+/// Squared distance between segments [p0, p1] and [q0, q1], m² (Ericson, *Real-Time
+/// Collision Detection*, §5.1.9).
+fn segment_distance_squared(
+    p0: &Vector3<f64>,
+    p1: &Vector3<f64>,
+    q0: &Vector3<f64>,
+    q1: &Vector3<f64>,
+) -> f64 {
+    let (d1, d2, r) = (p1 - p0, q1 - q0, p0 - q0);
+    let (a, e, f) = (d1.norm_squared(), d2.norm_squared(), d2.dot(&r));
+    let tiny = 1e-30;
+    let (s, t) = if a <= tiny && e <= tiny {
+        (0.0, 0.0)
+    } else if a <= tiny {
+        (0.0, (f / e).clamp(0.0, 1.0))
+    } else {
+        let c = d1.dot(&r);
+        if e <= tiny {
+            ((-c / a).clamp(0.0, 1.0), 0.0)
+        } else {
+            let b = d1.dot(&d2);
+            let denom = a * e - b * b;
+            let mut s = if denom > tiny { ((b * f - c * e) / denom).clamp(0.0, 1.0) } else { 0.0 };
+            let mut t = (b * s + f) / e;
+            if t < 0.0 {
+                t = 0.0;
+                s = (-c / a).clamp(0.0, 1.0);
+            } else if t > 1.0 {
+                t = 1.0;
+                s = ((b - c) / a).clamp(0.0, 1.0);
+            }
+            (s, t)
+        }
+    };
+    (p0 + d1 * s - (q0 + d2 * t)).norm_squared()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn segment_distance_matches_hand_cases() {
+        let z = Vector3::zeros();
+        let ex = Vector3::x();
+        // parallel segments 2 apart
+        let d = segment_distance_squared(&z, &ex, &Vector3::new(0.0, 2.0, 0.0), &Vector3::new(1.0, 2.0, 0.0));
+        assert!((d - 4.0).abs() < 1e-15);
+        // crossing skew segments 3 apart in z
+        let d = segment_distance_squared(
+            &Vector3::new(-1.0, 0.0, 0.0),
+            &ex,
+            &Vector3::new(0.0, -1.0, 3.0),
+            &Vector3::new(0.0, 1.0, 3.0),
+        );
+        assert!((d - 9.0).abs() < 1e-15);
+        // end to end along a line
+        let d = segment_distance_squared(&z, &ex, &Vector3::new(3.0, 0.0, 0.0), &Vector3::new(4.0, 0.0, 0.0));
+        assert!((d - 4.0).abs() < 1e-15);
+    }
 }

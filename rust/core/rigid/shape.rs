@@ -148,6 +148,8 @@ pub struct BeadClump {
     pub aabb_max: Vector3<f64>,
     /// Rotation from the body (principal) frame to the frame the beads were given in.
     pub principal_frame: UnitQuaternion<f64>,
+    /// Capsule along body z containing every bead.
+    pub bounding_capsule: BoundingCapsule,
 }
 
 impl BeadClump {
@@ -229,6 +231,13 @@ impl BeadClump {
         }
         let max_bead_radius = radii.iter().cloned().fold(0.0, f64::max);
         let min_bead_radius = radii.iter().cloned().fold(f64::INFINITY, f64::min);
+        // every bead centre lies within its radial distance of the axis segment at its own z
+        let mut capsule = BoundingCapsule { z_min: f64::INFINITY, z_max: f64::NEG_INFINITY, radius: 0.0 };
+        for (c, &r) in centers.iter().zip(&radii) {
+            capsule.z_min = capsule.z_min.min(c.z);
+            capsule.z_max = capsule.z_max.max(c.z);
+            capsule.radius = capsule.radius.max(c.x.hypot(c.y) + r);
+        }
         Self {
             centers,
             radii,
@@ -238,6 +247,7 @@ impl BeadClump {
             aabb_min,
             aabb_max,
             principal_frame,
+            bounding_capsule: capsule,
         }
     }
 
@@ -274,6 +284,8 @@ pub struct ExactShape {
     /// Points on the outer surface (rims of every station), body frame, m: used to bound the
     /// effective mass of a contact for the time step.
     pub rim_points: Vec<Vector3<f64>>,
+    /// Capsule along body z containing the shape.
+    pub bounding_capsule: BoundingCapsule,
 }
 
 impl std::fmt::Debug for ExactShape {
@@ -339,13 +351,31 @@ impl ExactShape {
                 detail: "no segment of positive length".into(),
             });
         }
+        let bounding_capsule = BoundingCapsule {
+            z_min: z[0] - center_of_mass_z,
+            z_max: z[z.len() - 1] - center_of_mass_z,
+            radius: r.iter().cloned().fold(0.0, f64::max),
+        };
         Ok(Self {
             compound: Compound::new(pieces),
             piece_contact_radius,
             bounding_radius,
             rim_points,
+            bounding_capsule,
         })
     }
+}
+
+/// A capsule around a shape in its body frame: the segment from (0, 0, z_min) to
+/// (0, 0, z_max) swept by a sphere of radius `radius`, m.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BoundingCapsule {
+    /// Lower end of the axis segment (body z), m.
+    pub z_min: f64,
+    /// Upper end of the axis segment (body z), m.
+    pub z_max: f64,
+    /// Radius, m.
+    pub radius: f64,
 }
 
 /// The shape of one rigid body.
@@ -363,6 +393,14 @@ impl RigidShape {
         match self {
             RigidShape::Clump(c) => c.bounding_radius,
             RigidShape::Exact(e) => e.bounding_radius,
+        }
+    }
+
+    /// Capsule along body z that contains the shape.
+    pub fn bounding_capsule(&self) -> BoundingCapsule {
+        match self {
+            RigidShape::Clump(c) => c.bounding_capsule,
+            RigidShape::Exact(e) => e.bounding_capsule,
         }
     }
 
