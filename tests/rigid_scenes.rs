@@ -182,3 +182,40 @@ fn tilted_cartridge_falls_over_when_its_centre_of_mass_is_outside_the_base() {
         assert!(largest < 5.0 + 0.05, "{kind}: from 5° it reached {largest}°");
     }
 }
+
+/// Upright on a belt that starts at 0.2 m/s: friction drags the cartridge; returns the
+/// speeds at 0.05 s and at the end, and the largest tilt, degrees.
+fn on_moving_belt(kind: &str, friction: f64, seconds: f64) -> (f64, f64, f64) {
+    let belt = RigidSceneConfig::belt(Vector3::new(0.2, 0.0, 0.0)).unwrap();
+    let config = RigidSceneConfig { friction, planes: vec![belt], ..Default::default() };
+    let (mut scene, id) = scene_with(config, kind);
+    // placed resting on the belt (its weight's Hertz overlap is < 1 µm)
+    scene.add_body(id, Vector3::new(0.0, 0.0, com_height()), UnitQuaternion::identity(), Vector3::zeros(), Vector3::zeros()).unwrap();
+    let chunk = (1e-3 / scene.time_step()) as u64;
+    let (mut early, mut largest) = (f64::NAN, 0.0_f64);
+    while scene.time() < seconds {
+        scene.run(chunk).unwrap();
+        largest = largest.max(tilt_degrees(&scene.bodies.orientation[0]));
+        if early.is_nan() && scene.time() >= 0.05 {
+            early = scene.bodies.velocity[0].x;
+        }
+    }
+    (early, scene.bodies.velocity[0].x, largest)
+}
+
+#[test]
+fn belt_friction_accelerates_at_mu_g_and_tips_only_above_r_over_h() {
+    // sliding on its base the cartridge accelerates at μ g until it moves with the belt; the
+    // friction at the base tips it over when μ g exceeds g r/h (r/h = 5.8/30.7 = 0.19)
+    for kind in ["clump", "exact"] {
+        let mu = 0.1;
+        let (early, late, largest) = on_moving_belt(kind, mu, 0.3);
+        println!("{kind} μ = {mu}: v(0.05 s) = {early:.4} m/s, v(0.3 s) = {late:.4} m/s, tilt ≤ {largest:.3}°");
+        assert!((early / (mu * 9.81 * 0.05) - 1.0).abs() < 0.1, "{kind}: v(0.05) = {early}");
+        assert!((late - 0.2).abs() < 0.005, "{kind}: final speed {late}");
+        assert!(largest < 2.0, "{kind}: tilted {largest}°");
+        let (_, _, tipped) = on_moving_belt(kind, 0.4, 0.3);
+        println!("{kind} μ = 0.4: tilt reached {tipped:.1}°");
+        assert!(tipped > 45.0, "{kind}: μ = 0.4 did not tip it ({tipped}°)");
+    }
+}
