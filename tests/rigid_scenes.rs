@@ -219,3 +219,34 @@ fn belt_friction_accelerates_at_mu_g_and_tips_only_above_r_over_h() {
         assert!(tipped > 45.0, "{kind}: μ = 0.4 did not tip it ({tipped}°)");
     }
 }
+
+/// A cartridge lying with its axis down a slope of `slope` degrees (gravity tilted instead
+/// of the belt), μ = 0.3; returns its speed along the slope after `seconds`.
+fn lying_on_slope(kind: &str, slope: f64, seconds: f64) -> f64 {
+    let a = slope.to_radians();
+    let config = RigidSceneConfig {
+        gravity: Vector3::new(9.81 * a.sin(), 0.0, -9.81 * a.cos()),
+        friction: 0.3,
+        ..belt_config()
+    };
+    let (mut scene, id) = scene_with(config, kind);
+    let lying = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), std::f64::consts::FRAC_PI_2);
+    scene.add_body(id, Vector3::new(0.0, 0.0, 5.8e-3 + 1e-7), lying, Vector3::zeros(), Vector3::zeros()).unwrap();
+    scene.run((seconds / scene.time_step()) as u64).unwrap();
+    scene.bodies.velocity[0].x
+}
+
+#[test]
+fn static_friction_holds_below_atan_mu_and_slides_at_the_coulomb_rate_above() {
+    for kind in ["clump", "exact"] {
+        // tan 10° = 0.18 < μ: the Mindlin springs hold it (no creep)
+        let held = lying_on_slope(kind, 10.0, 0.1);
+        // tan 25° = 0.47 > μ: it slides with a = g (sin α − μ cos α)
+        let sliding = lying_on_slope(kind, 25.0, 0.1);
+        let a = 25f64.to_radians();
+        let expected = 9.81 * (a.sin() - 0.3 * a.cos()) * 0.1;
+        println!("{kind}: speed at 10° {held:e} m/s, at 25° {sliding:.4} vs {expected:.4} m/s");
+        assert!(held.abs() < 1e-4, "{kind}: creeps at {held} m/s");
+        assert!((sliding / expected - 1.0).abs() < 0.05, "{kind}: {sliding} vs {expected}");
+    }
+}

@@ -30,10 +30,11 @@ pub struct ContactPoint {
     pub radius_first: f64,
     /// Curvature radius of the second surface at the contact, m (`inf` for a plane).
     pub radius_second: f64,
-    /// Bead index or parry piece index on the first object (0 for a plane or sphere).
-    pub feature_first: u32,
-    /// Bead index or parry piece index on the second object (0 for a plane or sphere).
-    pub feature_second: u32,
+    /// Feature of the first object that touches: the bead index for a clump, `piece << 32 |
+    /// parry feature id` for an exact shape, 0 for a plane or sphere. Keys friction history.
+    pub feature_first: u64,
+    /// Feature of the second object, as `feature_first`.
+    pub feature_second: u64,
 }
 
 /// An infinite plane bounding a solid half-space (the belt, a wall).
@@ -119,7 +120,7 @@ pub fn clump_plane_contacts(
                 radius_first: f64::INFINITY,
                 radius_second: r,
                 feature_first: 0,
-                feature_second: i as u32,
+                feature_second: i as u64,
             });
         }
     }
@@ -153,7 +154,7 @@ pub fn clump_sphere_contacts(
                 overlap,
                 radius_first: r,
                 radius_second: sphere_radius,
-                feature_first: i as u32,
+                feature_first: i as u64,
                 feature_second: 0,
             });
         }
@@ -244,8 +245,8 @@ pub fn clump_clump_contacts(
                     overlap,
                     radius_first: ra,
                     radius_second: rb,
-                    feature_first: i,
-                    feature_second: j,
+                    feature_first: i as u64,
+                    feature_second: j as u64,
                 });
             }
         }
@@ -309,8 +310,11 @@ fn manifold_contacts(
             let (r1, r2) = (radius1(manifold.subshape1), radius2(manifold.subshape2));
             let overlap = -contact.dist;
             let reach = HULL_EDGE_ANGLE * [r1, r2].into_iter().filter(|r| r.is_finite()).fold(0.0, f64::max);
+            let feature_first = piece_feature(manifold.subshape1, contact.fid1.0);
+            let feature_second = piece_feature(manifold.subshape2, contact.fid2.0);
             let same_contact = out[first_new..].iter().position(|c| {
-                (c.feature_first != manifold.subshape1 || c.feature_second != manifold.subshape2)
+                ((c.feature_first >> 32) as u32 != manifold.subshape1
+                    || (c.feature_second >> 32) as u32 != manifold.subshape2)
                     && (c.point - point).norm() < reach
                     && c.normal.dot(&normal) > 0.999
             });
@@ -323,8 +327,8 @@ fn manifold_contacts(
                         overlap,
                         radius_first: r1,
                         radius_second: r2,
-                        feature_first: manifold.subshape1,
-                        feature_second: manifold.subshape2,
+                        feature_first,
+                        feature_second,
                     };
                 }
                 continue;
@@ -333,14 +337,20 @@ fn manifold_contacts(
                 point,
                 normal,
                 overlap: -contact.dist,
-                radius_first: radius1(manifold.subshape1),
-                radius_second: radius2(manifold.subshape2),
-                feature_first: manifold.subshape1,
-                feature_second: manifold.subshape2,
+                radius_first: r1,
+                radius_second: r2,
+                feature_first,
+                feature_second,
             });
         }
     }
     Ok(())
+}
+
+/// Feature key of an exact-shape contact: piece in the high half, parry feature id below.
+#[inline]
+fn piece_feature(piece: u32, feature: u32) -> u64 {
+    ((piece as u64) << 32) | feature as u64
 }
 
 fn piece_radius(shape: &ExactShape) -> impl Fn(u32) -> f64 + '_ {
@@ -464,8 +474,8 @@ pub fn clump_exact_contacts(
                     overlap: -contact.dist,
                     radius_first: r,
                     radius_second: piece_radius(shape)(contact.subshape2),
-                    feature_first: i as u32,
-                    feature_second: contact.subshape2,
+                    feature_first: i as u64,
+                    feature_second: piece_feature(contact.subshape2, 0),
                 });
             }
         }

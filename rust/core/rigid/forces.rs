@@ -8,11 +8,14 @@
 //! the usual clump choice; when several beads touch at once or the contact is far from the
 //! centre of mass the realised restitution differs from the requested one.
 //!
-//! Tangential: history-free, viscous-regularised Coulomb friction,
-//! F_t = −min(μ F_n, c_t |v_t|) v̂_t with c_t = 2 √(m* · dF_n/dδ) (critical damping of the
-//! normal spring). It cannot hold a body at rest on a slope indefinitely (it creeps at
-//! v_t = μ F_n / c_t), which is acceptable for impacts and tipping but not for static
-//! friction; a Mindlin spring with history is the next step.
+//! Tangential: a Mindlin spring with Coulomb cap (the design's choice), history kept per
+//! contact by the caller (the scene keys it by body, body, feature, feature). The spring
+//! displacement ξ is turned into the current tangent plane and grows by v_t Δt; the force is
+//! F_t = −k_t ξ − c_t v_t with k_t = 2(1−ν)/(2−ν) · dF_n/dδ (Mindlin's no-slip stiffness
+//! relative to the Hertz tangent stiffness, same material) and c_t = the normal dashpot
+//! coefficient. When |F_t| > μ F_n the force is capped and ξ reset to −F_t/k_t, so the spring
+//! holds the contact at the sliding limit (static friction: a body on a slope below atan μ
+//! stays put). Without friction (μ = 0) no history is kept or needed.
 
 use nalgebra::Vector3;
 
@@ -49,6 +52,8 @@ pub struct ContactModel {
     pub damping_zeta: f64,
     /// Coulomb friction coefficient μ.
     pub friction: f64,
+    /// Mindlin tangential to Hertz normal tangent-stiffness ratio, 2(1−ν)/(2−ν).
+    pub tangential_stiffness_ratio: f64,
 }
 
 impl ContactModel {
@@ -74,13 +79,17 @@ impl ContactModel {
         )?;
         let damping_zeta = tsuji_damping_for_restitution(restitution, ForceClamp::NonNegative)?;
         check_non_negative("friction", friction)?;
-        Ok(Self { e_star_body_body, e_star_body_plane, damping_zeta, friction })
+        let nu = body.poisson_ratio;
+        let tangential_stiffness_ratio = 2.0 * (1.0 - nu) / (2.0 - nu);
+        Ok(Self { e_star_body_body, e_star_body_plane, damping_zeta, friction, tangential_stiffness_ratio })
     }
 
     /// Force on the second object of `contact` (the first receives its opposite), N.
     ///
     /// `relative_velocity` is the velocity of the second surface minus the first at the
-    /// contact point (m/s), `effective_mass` m* (kg), `e_star` the effective modulus (Pa).
+    /// contact point (m/s), `effective_mass` m* (kg), `e_star` the effective modulus (Pa),
+    /// `tangential_displacement` the contact's Mindlin spring ξ (m, zero for a new contact;
+    /// updated in place) and `dt` the time step (s).
     #[inline]
     pub fn force(
         &self,
@@ -88,6 +97,8 @@ impl ContactModel {
         relative_velocity: &Vector3<f64>,
         effective_mass: f64,
         e_star: f64,
+        tangential_displacement: &mut Vector3<f64>,
+        dt: f64,
     ) -> Result<Vector3<f64>> {
         // effective_radius takes a plane (inf) only as its second argument
         let (r1, r2) = if contact.radius_first.is_infinite() {
@@ -100,19 +111,31 @@ impl ContactModel {
         let (elastic, stiffness) = NormalLaw::Hertz { k_h }.force_and_stiffness(contact.overlap);
         let n = contact.normal;
         let normal_speed = relative_velocity.dot(&n); // < 0 while approaching
-        let overlap_rate = -normal_speed;
-        let damping =
+        let dashpot =
             self.damping_zeta * (effective_mass * k_h).sqrt() * contact.overlap.sqrt().sqrt();
-        let normal_force = (elastic + damping * overlap_rate).max(0.0);
+        let normal_force = (elastic - dashpot * normal_speed).max(0.0);
         let mut force = n * normal_force;
         if self.friction > 0.0 {
             let slip = relative_velocity - n * normal_speed;
-            let slip_speed = slip.norm();
-            if slip_speed > 0.0 {
-                let viscous = 2.0 * (effective_mass * stiffness).sqrt() * slip_speed;
-                let magnitude = viscous.min(self.friction * normal_force);
-                force -= slip * (magnitude / slip_speed);
+            // turn the old spring into the current tangent plane, keeping its length
+            let xi = *tangential_displacement;
+            let length = xi.norm();
+            let mut turned = xi - n * n.dot(&xi);
+            let turned_length = turned.norm();
+            if turned_length > 0.0 {
+                turned *= length / turned_length;
             }
+            turned += slip * dt;
+            let k_t = self.tangential_stiffness_ratio * stiffness;
+            let mut tangential = -turned * k_t - slip * dashpot;
+            let cap = self.friction * normal_force;
+            let magnitude = tangential.norm();
+            if magnitude > cap {
+                tangential *= cap / magnitude;
+                turned = if k_t > 0.0 { -tangential / k_t } else { Vector3::zeros() };
+            }
+            *tangential_displacement = turned;
+            force += tangential;
         }
         Ok(force)
     }
@@ -139,17 +162,28 @@ mod tests {
         let model =
             ContactModel::new(ContactMaterial::PAPER_GLASS, ContactMaterial::PAPER_GLASS, 1.0, 0.0)
                 .unwrap();
-        let f = model.force(&contact(1e-6), &Vector3::zeros(), 1e-3, 20e9).unwrap();
+        let f = model
+            .force(&contact(1e-6), &Vector3::zeros(), 1e-3, 20e9, &mut Vector3::zeros(), 1e-6)
+            .unwrap();
         let expected = 4.0 / 3.0 * (1e-3_f64).sqrt() * 20e9 * (1e-6_f64).powf(1.5);
         assert!((f.z / expected - 1.0).abs() < 1e-12 && f.x == 0.0 && f.y == 0.0);
     }
 
     #[test]
-    fn friction_is_capped_by_coulomb() {
+    fn friction_is_capped_by_coulomb_and_sticks_below_it() {
         let model =
             ContactModel::new(ContactMaterial::PAPER_GLASS, ContactMaterial::PAPER_GLASS, 1.0, 0.3)
                 .unwrap();
-        let f = model.force(&contact(1e-6), &Vector3::new(10.0, 0.0, 0.0), 1e-3, 20e9).unwrap();
+        let mut xi = Vector3::zeros();
+        let f = model.force(&contact(1e-6), &Vector3::new(10.0, 0.0, 0.0), 1e-3, 20e9, &mut xi, 1e-6).unwrap();
         assert!((f.x + 0.3 * f.z).abs() < 1e-12 * f.z, "{f:?}");
+        // at the cap the spring holds exactly the Coulomb force
+        let k_t = model.tangential_stiffness_ratio * 1.5 * 4.0 / 3.0 * (1e-3_f64).sqrt() * 20e9 * 1e-3;
+        assert!((xi.x * k_t - 0.3 * f.z).abs() < 1e-9 * f.z, "{xi:?}");
+        // a small displacement below the cap: the spring force −k_t ξ, no sliding
+        let mut xi = Vector3::new(1e-9, 0.0, 0.0);
+        let f = model.force(&contact(1e-6), &Vector3::zeros(), 1e-3, 20e9, &mut xi, 1e-6).unwrap();
+        assert!((f.x + k_t * 1e-9).abs() < 1e-9 * k_t * 1e-9, "{f:?}");
+        assert_eq!(xi, Vector3::new(1e-9, 0.0, 0.0));
     }
 }

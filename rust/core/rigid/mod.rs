@@ -5,7 +5,7 @@
 //! - [`body`]: state (structure of arrays) and the symplectic rigid-body integrator;
 //! - [`shape`]: the body of revolution, the bead clump and the exact parry compound;
 //! - [`collision`]: contact points between shapes, planes and spheres (pure geometry);
-//! - [`forces`]: Hertz + Tsuji normal force and regularised Coulomb friction per contact;
+//! - [`forces`]: Hertz + Tsuji normal force and Mindlin–Coulomb friction per contact;
 //! - [`scene`]: gravity, belt, walls, time-step limit and the step loop.
 //!
 //! Self-contained: nothing here depends on the sphere DEM in `dem/` or `geometry/`.

@@ -19,6 +19,7 @@
 //! with ~60 beads at once and would keep a restitution of ~0.15 instead of 0.5).
 
 use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
 
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 
@@ -80,6 +81,35 @@ impl RigidSceneConfig {
     }
 }
 
+/// Key of a contact's friction history: (first object << 32 | second object, feature on the
+/// first, feature on the second); planes are objects `u32::MAX − plane index`.
+type ContactKey = (u64, u64, u64);
+
+/// Multiply–rotate hash for small integer keys (the FxHash scheme): the default SipHash
+/// would cost more than the force it looks up.
+#[derive(Default, Clone, Copy)]
+struct ContactKeyHasher(u64);
+
+impl Hasher for ContactKeyHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(b as u64);
+        }
+    }
+    fn write_u64(&mut self, value: u64) {
+        self.0 = (self.0.rotate_left(5) ^ value).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+}
+
+type FrictionHistory = HashMap<ContactKey, Vector3<f64>, BuildHasherDefault<ContactKeyHasher>>;
+
+fn plane_object(plane: usize) -> u64 {
+    (u32::MAX as u64) - plane as u64
+}
+
 /// Rigid bodies with shapes, planes and the step loop.
 #[derive(Debug)]
 pub struct RigidScene {
@@ -101,6 +131,8 @@ pub struct RigidScene {
     exact_caches: HashMap<(usize, usize), ExactContactCache>,
     sweep_order: Vec<(f64, f64, usize)>,
     evaluations: u64,
+    friction_history: FrictionHistory,
+    friction_history_next: FrictionHistory,
     contacts_last_step: usize,
     max_overlap_last_step: f64,
 }
@@ -142,6 +174,8 @@ impl RigidScene {
             exact_caches: HashMap::new(),
             sweep_order: Vec::new(),
             evaluations: 0,
+            friction_history: FrictionHistory::default(),
+            friction_history_next: FrictionHistory::default(),
             contacts_last_step: 0,
             max_overlap_last_step: 0.0,
         })
@@ -296,6 +330,12 @@ impl RigidScene {
         self.bodies.clear_forces();
         self.evaluations += 1;
         let evaluation = self.evaluations;
+        let dt = self.time_step;
+        // friction history: springs of contacts that persist carry over, the rest are dropped
+        let with_history = self.model.friction > 0.0;
+        let previous = std::mem::take(&mut self.friction_history);
+        let mut current = std::mem::take(&mut self.friction_history_next);
+        current.clear();
         for i in 0..self.bodies.len() {
             self.bodies.force[i] = self.gravity * self.bodies.mass[i];
         }
@@ -323,7 +363,16 @@ impl RigidScene {
                 for c in &contacts {
                     max_overlap = max_overlap.max(c.overlap);
                     let relative = self.bodies.point_velocity(i, &c.point) - plane.surface_velocity;
-                    let f = self.model.force(c, &relative, m_star, self.model.e_star_body_plane)?;
+                    let key = (plane_object(p) << 32 | i as u64, c.feature_first, c.feature_second);
+                    let mut xi = if with_history {
+                        previous.get(&key).copied().unwrap_or_else(Vector3::zeros)
+                    } else {
+                        Vector3::zeros()
+                    };
+                    let f = self.model.force(c, &relative, m_star, self.model.e_star_body_plane, &mut xi, dt)?;
+                    if with_history {
+                        current.insert(key, xi);
+                    }
                     self.apply(i, &c.point, &f);
                 }
             }
@@ -384,7 +433,16 @@ impl RigidScene {
                     max_overlap = max_overlap.max(c.overlap);
                     let relative = self.bodies.point_velocity(second, &c.point)
                         - self.bodies.point_velocity(first, &c.point);
-                    let f = self.model.force(c, &relative, m_star, self.model.e_star_body_body)?;
+                    let key = ((first as u64) << 32 | second as u64, c.feature_first, c.feature_second);
+                    let mut xi = if with_history {
+                        previous.get(&key).copied().unwrap_or_else(Vector3::zeros)
+                    } else {
+                        Vector3::zeros()
+                    };
+                    let f = self.model.force(c, &relative, m_star, self.model.e_star_body_body, &mut xi, dt)?;
+                    if with_history {
+                        current.insert(key, xi);
+                    }
                     self.apply(second, &c.point, &f);
                     self.apply(first, &c.point, &(-f));
                 }
@@ -396,6 +454,8 @@ impl RigidScene {
         }
         self.contacts = contacts;
         self.sweep_order = order;
+        self.friction_history = current;
+        self.friction_history_next = previous;
         self.contacts_last_step = count;
         self.max_overlap_last_step = max_overlap;
         self.forces_current = true;
