@@ -169,3 +169,43 @@ fn time_step_above_the_limit_is_refused() {
         .unwrap_err();
     assert!(matches!(err, DemfemError::UnstableTimeStep { .. }), "{err}");
 }
+
+#[test]
+fn culled_clump_pairs_find_every_bead_pair_at_any_orientation() {
+    let (clump, _) = cartridge_clump();
+    let pose_a = BodyPose {
+        position: Vector3::new(0.001, -0.002, 0.003),
+        orientation: UnitQuaternion::from_euler_angles(0.4, -1.1, 0.3),
+    };
+    let mut scratch = ClumpPairScratch::default();
+    for (k, angles) in [(0.0, 0.7, 0.2), (1.2, 0.1, -0.8), (2.0, 1.5, 0.9), (0.3, 3.0, 0.0)].iter().enumerate() {
+        let orientation = UnitQuaternion::from_euler_angles(angles.0, angles.1, angles.2);
+        // move b toward a along a fixed direction until their beads just interpenetrate
+        let dir = Vector3::new(1.0, 0.5 - k as f64 * 0.3, 0.2).normalize();
+        let beads = |pose: &BodyPose| -> Vec<Vector3<f64>> {
+            clump.centers.iter().map(|c| pose.position + pose.orientation * c).collect()
+        };
+        let world_a = beads(&pose_a);
+        let mut distance = 0.068; // just beyond the two bounding spheres
+        let (pose_b, brute) = loop {
+            let pose_b = BodyPose { position: pose_a.position + dir * distance, orientation };
+            let world_b = beads(&pose_b);
+            let mut n = 0;
+            for pa in &world_a {
+                for pb in &world_b {
+                    if (pb - pa).norm() < 2.0 * clump.max_bead_radius {
+                        n += 1;
+                    }
+                }
+            }
+            if n >= 3 || distance < 0.0 {
+                break (pose_b, n);
+            }
+            distance -= 1e-4;
+        };
+        let mut out = Vec::new();
+        clump_clump_contacts(&clump, &pose_a, &clump, &pose_b, &mut scratch, &mut out);
+        assert_eq!(out.len(), brute, "orientation {k}");
+        assert!(brute >= 3);
+    }
+}

@@ -198,21 +198,33 @@ pub fn clump_clump_contacts(
     scratch.second.clear();
     let mut lo = Vector3::repeat(f64::INFINITY);
     let mut hi = Vector3::repeat(f64::NEG_INFINITY);
-    for (j, c) in b.centers.iter().enumerate() {
-        let in_a = t + rot_ab * c;
-        if inside(&in_a, a, b.radii[j]) {
-            lo = lo.inf(&in_a);
-            hi = hi.sup(&in_a);
-            scratch.second.push((0.0, j as u32, in_a));
+    // only the bead groups whose spheres reach the other body's box are opened
+    for chunk in &b.chunks {
+        if !inside(&(t + rot_ab * chunk.center), a, chunk.radius) {
+            continue;
+        }
+        for &j in &b.chunk_members[chunk.members.clone()] {
+            let in_a = t + rot_ab * b.centers[j as usize];
+            if inside(&in_a, a, b.radii[j as usize]) {
+                lo = lo.inf(&in_a);
+                hi = hi.sup(&in_a);
+                scratch.second.push((0.0, j, in_a));
+            }
         }
     }
     if scratch.second.is_empty() {
         return;
     }
-    for (i, c) in a.centers.iter().enumerate() {
-        let in_b = rot_ab.transpose() * (c - t);
-        if inside(&in_b, b, a.radii[i]) {
-            scratch.first.push((i as u32, *c));
+    let rot_ba = rot_ab.transpose();
+    for chunk in &a.chunks {
+        if !inside(&(rot_ba * (chunk.center - t)), b, chunk.radius) {
+            continue;
+        }
+        for &i in &a.chunk_members[chunk.members.clone()] {
+            let c = a.centers[i as usize];
+            if inside(&(rot_ba * (c - t)), b, a.radii[i as usize]) {
+                scratch.first.push((i, c));
+            }
         }
     }
     let spread = hi - lo;

@@ -150,6 +150,59 @@ pub struct BeadClump {
     pub principal_frame: UnitQuaternion<f64>,
     /// Capsule along body z containing every bead.
     pub bounding_capsule: BoundingCapsule,
+    /// Groups of nearby beads (≤ [`BEADS_PER_CHUNK`]) with bounding spheres, so a pair
+    /// test transforms only the beads of groups that can reach the other body.
+    pub chunks: Vec<BeadChunk>,
+    /// Bead indices, grouped: chunk k owns `chunk_members[chunks[k].members.clone()]`.
+    pub chunk_members: Vec<u32>,
+}
+
+/// Most beads in one [`BeadChunk`].
+pub const BEADS_PER_CHUNK: usize = 16;
+
+/// A group of nearby beads of a clump and the sphere around them (body frame).
+#[derive(Debug, Clone, PartialEq)]
+pub struct BeadChunk {
+    /// Centre of the bounding sphere, m.
+    pub center: Vector3<f64>,
+    /// Radius of the bounding sphere (bead radii included), m.
+    pub radius: f64,
+    /// Range of this chunk's entries in `BeadClump::chunk_members`.
+    pub members: std::ops::Range<usize>,
+}
+
+/// Split `members` at the median of the longest axis of their centres until each group has
+/// at most [`BEADS_PER_CHUNK`] beads (a k-d tree's leaves).
+fn split_into_chunks(
+    centers: &[Vector3<f64>],
+    radii: &[f64],
+    members: &mut [u32],
+    offset: usize,
+    chunks: &mut Vec<BeadChunk>,
+) {
+    let mut lo = Vector3::repeat(f64::INFINITY);
+    let mut hi = Vector3::repeat(f64::NEG_INFINITY);
+    for &m in members.iter() {
+        lo = lo.inf(&centers[m as usize]);
+        hi = hi.sup(&centers[m as usize]);
+    }
+    if members.len() <= BEADS_PER_CHUNK {
+        let center = 0.5 * (lo + hi);
+        let radius = members
+            .iter()
+            .map(|&m| (centers[m as usize] - center).norm() + radii[m as usize])
+            .fold(0.0, f64::max);
+        chunks.push(BeadChunk { center, radius, members: offset..offset + members.len() });
+        return;
+    }
+    let axis = (hi - lo).imax();
+    let half = members.len() / 2;
+    members.select_nth_unstable_by(half, |&a, &b| {
+        centers[a as usize][axis].total_cmp(&centers[b as usize][axis])
+    });
+    let (left, right) = members.split_at_mut(half);
+    split_into_chunks(centers, radii, left, offset, chunks);
+    split_into_chunks(centers, radii, right, offset + half, chunks);
 }
 
 impl BeadClump {
@@ -238,6 +291,9 @@ impl BeadClump {
             capsule.z_max = capsule.z_max.max(c.z);
             capsule.radius = capsule.radius.max(c.x.hypot(c.y) + r);
         }
+        let mut chunk_members: Vec<u32> = (0..centers.len() as u32).collect();
+        let mut chunks = Vec::new();
+        split_into_chunks(&centers, &radii, &mut chunk_members, 0, &mut chunks);
         Self {
             centers,
             radii,
@@ -248,6 +304,8 @@ impl BeadClump {
             aabb_max,
             principal_frame,
             bounding_capsule: capsule,
+            chunks,
+            chunk_members,
         }
     }
 
