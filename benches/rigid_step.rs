@@ -52,7 +52,13 @@ fn cluster(kind: &str, n: usize) -> RigidScene {
         let x = pitch * (i + 0.5 * (j % 2.0));
         let y = pitch * j * 3f64.sqrt() / 2.0;
         scene
-            .add_body(id, Vector3::new(x, y, height), UnitQuaternion::identity(), Vector3::zeros(), Vector3::zeros())
+            .add_body(
+                id,
+                Vector3::new(x, y, height),
+                UnitQuaternion::identity(),
+                Vector3::zeros(),
+                Vector3::zeros(),
+            )
             .unwrap();
     }
     let settle = (2e-3 / scene.time_step()) as u64;
@@ -86,10 +92,20 @@ impl SphereLoop {
         let x = (0..n)
             .map(|k| {
                 let (i, j) = ((k % side) as f64, (k / side) as f64);
-                Vector3::new(2.0 * r * (i + 0.5 * (j % 2.0)), 2.0 * r * j * 3f64.sqrt() / 2.0, r)
+                Vector3::new(
+                    2.0 * r * (i + 0.5 * (j % 2.0)),
+                    2.0 * r * j * 3f64.sqrt() / 2.0,
+                    r,
+                )
             })
             .collect();
-        let model = ContactModel::new(ContactMaterial::PAPER_GLASS, ContactMaterial::PAPER_GLASS, 0.5, 0.2).unwrap();
+        let model = ContactModel::new(
+            ContactMaterial::PAPER_GLASS,
+            ContactMaterial::PAPER_GLASS,
+            0.5,
+            0.2,
+        )
+        .unwrap();
         let mut s = Self {
             x,
             v: vec![Vector3::zeros(); n],
@@ -130,16 +146,30 @@ impl SphereLoop {
                     feature_first: 0,
                     feature_second: 0,
                 };
-                let rel = self.v[i] + self.w[i].cross(&(c.point - self.x[i])) - self.belt.surface_velocity;
-                let mut xi = history.remove(&(usize::MAX, i)).unwrap_or_else(Vector3::zeros);
-                let f = self.model.force(&c, &rel, self.mass, self.model.e_star_body_plane, &mut xi, dt).unwrap();
+                let rel = self.v[i] + self.w[i].cross(&(c.point - self.x[i]))
+                    - self.belt.surface_velocity;
+                let mut xi = history
+                    .remove(&(usize::MAX, i))
+                    .unwrap_or_else(Vector3::zeros);
+                let f = self
+                    .model
+                    .force(
+                        &c,
+                        &rel,
+                        self.mass,
+                        self.model.e_star_body_plane,
+                        &mut xi,
+                        dt,
+                    )
+                    .unwrap();
                 next.insert((usize::MAX, i), xi);
                 self.f[i] += f;
                 self.t[i] += (c.point - self.x[i]).cross(&f);
             }
         }
         self.order.clear();
-        self.order.extend(self.x.iter().enumerate().map(|(i, x)| (x.x - r, i)));
+        self.order
+            .extend(self.x.iter().enumerate().map(|(i, x)| (x.x - r, i)));
         self.order.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
         for k in 0..self.order.len() {
             let (lower_a, a) = self.order[k];
@@ -155,11 +185,31 @@ impl SphereLoop {
                 let n = d / dist;
                 let overlap = 2.0 * r - dist;
                 let point = self.x[a] + n * (r - 0.5 * overlap);
-                let c = ContactPoint { point, normal: n, overlap, radius_first: r, radius_second: r, feature_first: 0, feature_second: 0 };
-                let rel = self.v[b] + self.w[b].cross(&(point - self.x[b])) - self.v[a] - self.w[a].cross(&(point - self.x[a]));
+                let c = ContactPoint {
+                    point,
+                    normal: n,
+                    overlap,
+                    radius_first: r,
+                    radius_second: r,
+                    feature_first: 0,
+                    feature_second: 0,
+                };
+                let rel = self.v[b] + self.w[b].cross(&(point - self.x[b]))
+                    - self.v[a]
+                    - self.w[a].cross(&(point - self.x[a]));
                 let key = (a.min(b), a.max(b));
                 let mut xi = history.remove(&key).unwrap_or_else(Vector3::zeros);
-                let f = self.model.force(&c, &rel, 0.5 * self.mass, self.model.e_star_body_body, &mut xi, dt).unwrap();
+                let f = self
+                    .model
+                    .force(
+                        &c,
+                        &rel,
+                        0.5 * self.mass,
+                        self.model.e_star_body_body,
+                        &mut xi,
+                        dt,
+                    )
+                    .unwrap();
                 next.insert(key, xi);
                 self.f[b] += f;
                 self.f[a] -= f;
@@ -188,7 +238,10 @@ impl SphereLoop {
 
 fn bench_rigid_step(c: &mut Criterion) {
     let mut group = c.benchmark_group("rigid_step");
-    group.sample_size(10).warm_up_time(Duration::from_millis(300)).measurement_time(Duration::from_secs(2));
+    group
+        .sample_size(10)
+        .warm_up_time(Duration::from_millis(300))
+        .measurement_time(Duration::from_secs(2));
     for n in [7usize, 50] {
         let dt = cluster("sphere", 1).time_step();
         let mut spheres = SphereLoop::cluster(n, dt);

@@ -13,7 +13,10 @@ use nalgebra::{UnitQuaternion, Vector3};
 use rigid_common::*;
 
 fn upright(x: f64, y: f64, z: f64) -> BodyPose {
-    BodyPose { position: Vector3::new(x, y, z), orientation: UnitQuaternion::identity() }
+    BodyPose {
+        position: Vector3::new(x, y, z),
+        orientation: UnitQuaternion::identity(),
+    }
 }
 
 fn floor() -> Plane {
@@ -32,7 +35,11 @@ fn clump_mass_properties_agree_with_exact_geometry() {
         assert!(rel.abs() < 0.01, "inertia {k}: {rel:e}");
     }
     // fixture centres are relative to the exact centre of mass
-    assert!(from_beads.center_of_mass.norm() < 1e-5, "{:?}", from_beads.center_of_mass);
+    assert!(
+        from_beads.center_of_mass.norm() < 1e-5,
+        "{:?}",
+        from_beads.center_of_mass
+    );
     // the clump spans the cartridge: 64 mm long, 11.6 mm across
     assert!((clump.aabb_max.x - clump.aabb_min.x - 11.6e-3).abs() < 1e-6);
     assert!((clump.aabb_max.z - clump.aabb_min.z - 64e-3).abs() < 1e-6);
@@ -42,11 +49,21 @@ fn clump_mass_properties_agree_with_exact_geometry() {
 fn upright_clump_sinking_into_the_floor_touches_with_its_bottom_ring() {
     let (clump, _) = cartridge_clump();
     let sink = 1e-5;
-    let bottom = clump.centers.iter().zip(&clump.radii).map(|(c, r)| c.z - r).fold(f64::INFINITY, f64::min);
+    let bottom = clump
+        .centers
+        .iter()
+        .zip(&clump.radii)
+        .map(|(c, r)| c.z - r)
+        .fold(f64::INFINITY, f64::min);
     let pose = upright(0.0, 0.0, -bottom - sink);
     let mut out = Vec::new();
     clump_plane_contacts(&floor(), &clump, &pose, &mut out);
-    let ring = clump.centers.iter().zip(&clump.radii).filter(|(c, r)| (c.z - *r - bottom).abs() < 1e-12).count();
+    let ring = clump
+        .centers
+        .iter()
+        .zip(&clump.radii)
+        .filter(|(c, r)| (c.z - *r - bottom).abs() < 1e-12)
+        .count();
     assert_eq!(out.len(), ring);
     for c in &out {
         assert!((c.overlap - sink).abs() < 1e-12);
@@ -54,7 +71,12 @@ fn upright_clump_sinking_into_the_floor_touches_with_its_bottom_ring() {
         assert!(c.point.z.abs() <= sink);
     }
     out.clear();
-    clump_plane_contacts(&floor(), &clump, &upright(0.0, 0.0, -bottom + 1e-6), &mut out);
+    clump_plane_contacts(
+        &floor(),
+        &clump,
+        &upright(0.0, 0.0, -bottom + 1e-6),
+        &mut out,
+    );
     assert!(out.is_empty());
 }
 
@@ -65,10 +87,21 @@ fn side_by_side_clumps_touch_along_their_sides() {
     let pose_b = upright(clump.aabb_max.x - clump.aabb_min.x + gap, 0.0, 0.0);
     let mut out = Vec::new();
     let mut scratch = ClumpPairScratch::default();
-    clump_clump_contacts(&clump, &upright(0.0, 0.0, 0.0), &clump, &pose_b, &mut scratch, &mut out);
+    clump_clump_contacts(
+        &clump,
+        &upright(0.0, 0.0, 0.0),
+        &clump,
+        &pose_b,
+        &mut scratch,
+        &mut out,
+    );
     assert!(!out.is_empty());
     for c in &out {
-        assert!(c.overlap > 0.0 && c.overlap <= -gap + 1e-12, "{}", c.overlap);
+        assert!(
+            c.overlap > 0.0 && c.overlap <= -gap + 1e-12,
+            "{}",
+            c.overlap
+        );
         assert!(c.normal.x > 0.95, "{:?}", c.normal);
     }
     // brute force gives the same pairs
@@ -93,11 +126,23 @@ fn sphere_against_clump_and_exact_side() {
     let centre = Vector3::new(5.8e-3 + radius - sink, 0.0, 0.0);
     let mut out = Vec::new();
     clump_sphere_contacts(&clump, &upright(0.0, 0.0, 0.0), &centre, radius, &mut out);
-    assert!(!out.is_empty() && out.iter().all(|c| c.normal.x > 0.9 && c.overlap <= sink + 1e-12));
+    assert!(
+        !out.is_empty()
+            && out
+                .iter()
+                .all(|c| c.normal.x > 0.9 && c.overlap <= sink + 1e-12)
+    );
     out.clear();
     let mut cache = ExactContactCache::default();
-    exact_sphere_contacts(&exact, &upright(0.0, 0.0, 0.0), &centre, radius, &mut cache, &mut out)
-        .unwrap();
+    exact_sphere_contacts(
+        &exact,
+        &upright(0.0, 0.0, 0.0),
+        &centre,
+        radius,
+        &mut cache,
+        &mut out,
+    )
+    .unwrap();
     assert_eq!(out.len(), 1);
     assert!((out[0].overlap - sink).abs() < 1e-9, "{}", out[0].overlap);
     assert!((out[0].normal - Vector3::x()).norm() < 1e-9);
@@ -111,7 +156,14 @@ fn exact_cartridge_on_the_floor_upright_and_lying() {
     let sink = 1e-5;
     let mut out = Vec::new();
     let mut cache = ExactContactCache::default();
-    exact_plane_contacts(&floor(), &exact, &upright(0.0, 0.0, zc - sink), &mut cache, &mut out).unwrap();
+    exact_plane_contacts(
+        &floor(),
+        &exact,
+        &upright(0.0, 0.0, zc - sink),
+        &mut cache,
+        &mut out,
+    )
+    .unwrap();
     // parry stands the cylinder's cap on four rim points
     assert_eq!(out.len(), 4);
     for c in &out {
@@ -122,12 +174,17 @@ fn exact_cartridge_on_the_floor_upright_and_lying() {
     out.clear();
     let lying = BodyPose {
         position: Vector3::new(0.0, 0.0, 5.8e-3 - sink),
-        orientation: UnitQuaternion::from_axis_angle(&Vector3::y_axis(), std::f64::consts::FRAC_PI_2),
+        orientation: UnitQuaternion::from_axis_angle(
+            &Vector3::y_axis(),
+            std::f64::consts::FRAC_PI_2,
+        ),
     };
     let mut cache = ExactContactCache::default();
     exact_plane_contacts(&floor(), &exact, &lying, &mut cache, &mut out).unwrap();
     assert!(out.len() >= 2);
-    assert!(out.iter().all(|c| (c.overlap - sink).abs() < 1e-9 && c.radius_second == 5.8e-3));
+    assert!(out
+        .iter()
+        .all(|c| (c.overlap - sink).abs() < 1e-9 && c.radius_second == 5.8e-3));
 }
 
 #[test]
@@ -138,7 +195,15 @@ fn exact_cartridges_side_by_side_and_bead_against_exact() {
     let b = upright(11.6e-3 - overlap, 0.0, 0.0);
     let mut out = Vec::new();
     let mut cache = ExactContactCache::default();
-    exact_exact_contacts(&exact, &upright(0.0, 0.0, 0.0), &exact, &b, &mut cache, &mut out).unwrap();
+    exact_exact_contacts(
+        &exact,
+        &upright(0.0, 0.0, 0.0),
+        &exact,
+        &b,
+        &mut cache,
+        &mut out,
+    )
+    .unwrap();
     assert!(!out.is_empty());
     for c in &out {
         assert!((c.overlap - overlap).abs() < 1e-9, "{}", c.overlap);
@@ -148,7 +213,9 @@ fn exact_cartridges_side_by_side_and_bead_against_exact() {
     out.clear();
     clump_exact_contacts(&clump, &upright(0.0, 0.0, 0.0), &exact, &b, &mut out).unwrap();
     assert!(!out.is_empty());
-    assert!(out.iter().all(|c| c.overlap > 0.0 && c.overlap <= overlap + 1e-9 && c.normal.x > 0.9));
+    assert!(out
+        .iter()
+        .all(|c| c.overlap > 0.0 && c.overlap <= overlap + 1e-9 && c.normal.x > 0.9));
 }
 
 #[test]
@@ -157,15 +224,30 @@ fn time_step_above_the_limit_is_refused() {
     let mut scene = RigidScene::new(RigidSceneConfig::default()).unwrap();
     let id = scene.add_shape(shape.clone(), mass).unwrap();
     scene
-        .add_body(id, Vector3::zeros(), UnitQuaternion::identity(), Vector3::zeros(), Vector3::zeros())
+        .add_body(
+            id,
+            Vector3::zeros(),
+            UnitQuaternion::identity(),
+            Vector3::zeros(),
+            Vector3::zeros(),
+        )
         .unwrap();
     let limit = scene.time_step_limit().unwrap();
     assert!(limit > 1e-7 && limit < 1e-5, "{limit}");
-    let config = RigidSceneConfig { time_step: Some(2.0 * limit), ..Default::default() };
+    let config = RigidSceneConfig {
+        time_step: Some(2.0 * limit),
+        ..Default::default()
+    };
     let mut scene = RigidScene::new(config).unwrap();
     let id = scene.add_shape(shape, mass).unwrap();
     let err = scene
-        .add_body(id, Vector3::zeros(), UnitQuaternion::identity(), Vector3::zeros(), Vector3::zeros())
+        .add_body(
+            id,
+            Vector3::zeros(),
+            UnitQuaternion::identity(),
+            Vector3::zeros(),
+            Vector3::zeros(),
+        )
         .unwrap_err();
     assert!(matches!(err, DemfemError::UnstableTimeStep { .. }), "{err}");
 }
@@ -178,17 +260,32 @@ fn culled_clump_pairs_find_every_bead_pair_at_any_orientation() {
         orientation: UnitQuaternion::from_euler_angles(0.4, -1.1, 0.3),
     };
     let mut scratch = ClumpPairScratch::default();
-    for (k, angles) in [(0.0, 0.7, 0.2), (1.2, 0.1, -0.8), (2.0, 1.5, 0.9), (0.3, 3.0, 0.0)].iter().enumerate() {
+    for (k, angles) in [
+        (0.0, 0.7, 0.2),
+        (1.2, 0.1, -0.8),
+        (2.0, 1.5, 0.9),
+        (0.3, 3.0, 0.0),
+    ]
+    .iter()
+    .enumerate()
+    {
         let orientation = UnitQuaternion::from_euler_angles(angles.0, angles.1, angles.2);
         // move b toward a along a fixed direction until their beads just interpenetrate
         let dir = Vector3::new(1.0, 0.5 - k as f64 * 0.3, 0.2).normalize();
         let beads = |pose: &BodyPose| -> Vec<Vector3<f64>> {
-            clump.centers.iter().map(|c| pose.position + pose.orientation * c).collect()
+            clump
+                .centers
+                .iter()
+                .map(|c| pose.position + pose.orientation * c)
+                .collect()
         };
         let world_a = beads(&pose_a);
         let mut distance = 0.068; // just beyond the two bounding spheres
         let (pose_b, brute) = loop {
-            let pose_b = BodyPose { position: pose_a.position + dir * distance, orientation };
+            let pose_b = BodyPose {
+                position: pose_a.position + dir * distance,
+                orientation,
+            };
             let world_b = beads(&pose_b);
             let mut n = 0;
             for pa in &world_a {

@@ -37,7 +37,11 @@ fn free_asymmetric_body_conserves_momentum_and_energy() {
         worst_energy = worst_energy.max((bodies.kinetic_energy(0) / e0 - 1.0).abs());
     }
     let l = bodies.angular_momentum_world(0);
-    assert!((l - l0).norm() <= 1e-12 * l0.norm(), "L drift {:e}", (l - l0).norm() / l0.norm());
+    assert!(
+        (l - l0).norm() <= 1e-12 * l0.norm(),
+        "L drift {:e}",
+        (l - l0).norm() / l0.norm()
+    );
     assert!(worst_energy < 1e-5, "energy error {worst_energy:e}");
     assert!((bodies.orientation[0].quaternion().norm() - 1.0).abs() < 1e-14);
 }
@@ -61,10 +65,16 @@ fn symmetric_top_precesses_at_closed_form_rate() {
         d -= (d / std::f64::consts::TAU).round() * std::f64::consts::TAU;
         angle += d;
         previous = now;
-        assert!((w.z - omega3).abs() < 1e-9, "ω3 must stay constant for a symmetric top");
+        assert!(
+            (w.z - omega3).abs() < 1e-9,
+            "ω3 must stay constant for a symmetric top"
+        );
     }
     let rate = angle / (h * steps as f64);
-    assert!((rate / expected - 1.0).abs() < 1e-4, "rate {rate} vs {expected}");
+    assert!(
+        (rate / expected - 1.0).abs() < 1e-4,
+        "rate {rate} vs {expected}"
+    );
 }
 
 #[test]
@@ -83,7 +93,10 @@ fn intermediate_axis_flips_but_conserves_momentum_and_energy() {
     // the spin about the intermediate axis reverses (body flips) and the perturbation grows
     // from 1e-3 to order |ω|
     assert!(seen_negative, "no flip: min ω_y = {min_wy}");
-    assert!(max_transverse > 1.0, "perturbation did not grow: {max_transverse}");
+    assert!(
+        max_transverse > 1.0,
+        "perturbation did not grow: {max_transverse}"
+    );
     let l = bodies.angular_momentum_world(0);
     assert!((l - l0).norm() <= 1e-12 * l0.norm());
     assert!((bodies.kinetic_energy(0) / e0 - 1.0).abs() < 1e-6);

@@ -27,7 +27,13 @@ fn drop_upright_and_settle(kind: &str) {
     let zc = com_height();
     let drop = 1e-3;
     scene
-        .add_body(id, Vector3::new(0.0, 0.0, zc + drop), UnitQuaternion::identity(), Vector3::zeros(), Vector3::zeros())
+        .add_body(
+            id,
+            Vector3::new(0.0, 0.0, zc + drop),
+            UnitQuaternion::identity(),
+            Vector3::zeros(),
+            Vector3::zeros(),
+        )
         .unwrap();
     let dt = scene.time_step();
     let steps = (0.15 / dt) as u64;
@@ -39,10 +45,24 @@ fn drop_upright_and_settle(kind: &str) {
     // overlap of the weight (< 1 µm here) and, for the clump, the 0.2 µm between the beads'
     // and the glass's centres of mass
     let height = b.position[0].z;
-    assert!((height - zc).abs() < 5e-6, "{kind}: height {height} vs {zc}");
-    assert!(b.velocity[0].norm() < 1e-3, "{kind}: still moving {:?}", b.velocity[0]);
-    assert!(scene.max_overlap_last_step() < 2e-6, "{kind}: overlap {}", scene.max_overlap_last_step());
-    println!("{kind}: dt {dt:e} s, {steps} steps, tilt {tilt:.2e}°, height error {:.2e} m", height - zc);
+    assert!(
+        (height - zc).abs() < 5e-6,
+        "{kind}: height {height} vs {zc}"
+    );
+    assert!(
+        b.velocity[0].norm() < 1e-3,
+        "{kind}: still moving {:?}",
+        b.velocity[0]
+    );
+    assert!(
+        scene.max_overlap_last_step() < 2e-6,
+        "{kind}: overlap {}",
+        scene.max_overlap_last_step()
+    );
+    println!(
+        "{kind}: dt {dt:e} s, {steps} steps, tilt {tilt:.2e}°, height error {:.2e} m",
+        height - zc
+    );
 }
 
 #[test]
@@ -73,10 +93,21 @@ fn head_on_pair(kind: &str, other_kind: &str, restitution: f64) -> (f64, f64, f6
     // integrated with a quarter of it so the Verlet error of the impact (∝ Δt²) is below 1e-4
     let limit = {
         let (mut probe, id) = scene_with(config.clone(), kind);
-        probe.add_body(id, Vector3::zeros(), UnitQuaternion::identity(), Vector3::zeros(), Vector3::zeros()).unwrap();
+        probe
+            .add_body(
+                id,
+                Vector3::zeros(),
+                UnitQuaternion::identity(),
+                Vector3::zeros(),
+                Vector3::zeros(),
+            )
+            .unwrap();
         probe.time_step_limit().unwrap()
     };
-    let config = RigidSceneConfig { time_step: Some(0.25 * limit), ..config };
+    let config = RigidSceneConfig {
+        time_step: Some(0.25 * limit),
+        ..config
+    };
     let (mut scene, id) = scene_with(config, kind);
     let other_id = if other_kind == kind {
         id
@@ -90,8 +121,24 @@ fn head_on_pair(kind: &str, other_kind: &str, restitution: f64) -> (f64, f64, f6
     // a along +z with its bottom at z = 0, b turned over (bottom up) just below it
     let flip = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI);
     let up = UnitQuaternion::identity();
-    scene.add_body(id, Vector3::new(0.0, 0.0, zc + gap), up, Vector3::new(0.0, 0.0, -v), Vector3::zeros()).unwrap();
-    scene.add_body(other_id, Vector3::new(0.0, 0.0, -zc - gap), flip, Vector3::new(0.0, 0.0, v), Vector3::zeros()).unwrap();
+    scene
+        .add_body(
+            id,
+            Vector3::new(0.0, 0.0, zc + gap),
+            up,
+            Vector3::new(0.0, 0.0, -v),
+            Vector3::zeros(),
+        )
+        .unwrap();
+    scene
+        .add_body(
+            other_id,
+            Vector3::new(0.0, 0.0, -zc - gap),
+            flip,
+            Vector3::new(0.0, 0.0, v),
+            Vector3::zeros(),
+        )
+        .unwrap();
     let p0 = scene.bodies.linear_momentum();
     let e0 = scene.bodies.kinetic_energy(0) + scene.bodies.kinetic_energy(1);
     let mut max_p_error: f64 = 0.0;
@@ -104,19 +151,32 @@ fn head_on_pair(kind: &str, other_kind: &str, restitution: f64) -> (f64, f64, f6
             break;
         }
     }
-    assert!(touched && scene.contacts_last_step() == 0, "{kind}: collision did not end");
+    assert!(
+        touched && scene.contacts_last_step() == 0,
+        "{kind}: collision did not end"
+    );
     let e1 = scene.bodies.kinetic_energy(0) + scene.bodies.kinetic_energy(1);
     let separation_speed = scene.bodies.velocity[0].z - scene.bodies.velocity[1].z;
-    (max_p_error / (scene.bodies.mass[0] * v), e1 / e0, separation_speed / (2.0 * v))
+    (
+        max_p_error / (scene.bodies.mass[0] * v),
+        e1 / e0,
+        separation_speed / (2.0 * v),
+    )
 }
 
 #[test]
 fn elastic_head_on_collision_conserves_momentum_and_energy() {
     for kind in ["clump", "exact"] {
         let (p_error, energy_ratio, restitution) = head_on(kind, 1.0);
-        println!("{kind} elastic: momentum error {p_error:e}, E1/E0 - 1 = {:e}, e = {restitution}", energy_ratio - 1.0);
+        println!(
+            "{kind} elastic: momentum error {p_error:e}, E1/E0 - 1 = {:e}, e = {restitution}",
+            energy_ratio - 1.0
+        );
         assert!(p_error < 1e-13, "{kind}: momentum error {p_error:e}");
-        assert!((energy_ratio - 1.0).abs() < 1e-4, "{kind}: E1/E0 = {energy_ratio}");
+        assert!(
+            (energy_ratio - 1.0).abs() < 1e-4,
+            "{kind}: E1/E0 = {energy_ratio}"
+        );
     }
 }
 
@@ -128,8 +188,14 @@ fn damped_head_on_collision_conserves_momentum_and_loses_energy() {
         assert!(p_error < 1e-13, "{kind}: momentum error {p_error:e}");
         // a central side-on hit between two equal bodies: the realised restitution is that of
         // the law (several bead contacts share the load, so allow ±0.1)
-        assert!((restitution - 0.5).abs() < 0.1, "{kind}: restitution {restitution}");
-        assert!(energy_ratio < 1.0 && energy_ratio > 0.15, "{kind}: E1/E0 = {energy_ratio}");
+        assert!(
+            (restitution - 0.5).abs() < 0.1,
+            "{kind}: restitution {restitution}"
+        );
+        assert!(
+            energy_ratio < 1.0 && energy_ratio > 0.15,
+            "{kind}: E1/E0 = {energy_ratio}"
+        );
     }
 }
 
@@ -148,37 +214,75 @@ fn clump_against_exact_shape_conserves_momentum() {
 #[test]
 fn no_cartridge_passes_through_a_wall_at_5_m_per_s() {
     for kind in ["clump", "exact"] {
-        let wall = Plane::new(Vector3::new(0.02, 0.0, 0.0), -Vector3::x(), Vector3::zeros()).unwrap();
-        let config = RigidSceneConfig { gravity: Vector3::zeros(), planes: vec![wall], ..Default::default() };
+        let wall = Plane::new(
+            Vector3::new(0.02, 0.0, 0.0),
+            -Vector3::x(),
+            Vector3::zeros(),
+        )
+        .unwrap();
+        let config = RigidSceneConfig {
+            gravity: Vector3::zeros(),
+            planes: vec![wall],
+            ..Default::default()
+        };
         let (mut scene, id) = scene_with(config, kind);
         // lying, axis along y, flying at the wall at 5 m/s
-        let lying = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::FRAC_PI_2);
-        scene.add_body(id, Vector3::zeros(), lying, Vector3::new(5.0, 0.0, 0.0), Vector3::zeros()).unwrap();
+        let lying =
+            UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::FRAC_PI_2);
+        scene
+            .add_body(
+                id,
+                Vector3::zeros(),
+                lying,
+                Vector3::new(5.0, 0.0, 0.0),
+                Vector3::zeros(),
+            )
+            .unwrap();
         let mut max_overlap: f64 = 0.0;
         for _ in 0..3000 {
             scene.run(5).unwrap();
             max_overlap = max_overlap.max(scene.max_overlap_last_step());
-            assert!(scene.bodies.position[0].x < 0.02, "{kind}: centre passed the wall");
+            assert!(
+                scene.bodies.position[0].x < 0.02,
+                "{kind}: centre passed the wall"
+            );
         }
         let vx = scene.bodies.velocity[0].x;
         println!("{kind} at 5 m/s: max overlap {max_overlap:e} m, rebound {vx} m/s");
         // the law's restitution is 0.5; a side-on hit with ~60 simultaneous bead contacts
         // (or parry's line contact) realises it only roughly
-        assert!(vx < -0.3 * 5.0 && vx > -0.7 * 5.0, "{kind}: rebound v_x = {vx}");
-        assert!(max_overlap > 0.0 && max_overlap < 0.1 * 0.55e-3, "{kind}: overlap {max_overlap}");
+        assert!(
+            vx < -0.3 * 5.0 && vx > -0.7 * 5.0,
+            "{kind}: rebound v_x = {vx}"
+        );
+        assert!(
+            max_overlap > 0.0 && max_overlap < 0.1 * 0.55e-3,
+            "{kind}: overlap {max_overlap}"
+        );
     }
 }
 
 /// Released at rest, tilted by `tilt` degrees about x, standing on its bottom rim; returns
 /// the final tilt and the largest tilt seen, degrees.
 fn release_tilted(kind: &str, tilt: f64, seconds: f64) -> (f64, f64) {
-    let config = RigidSceneConfig { friction: 0.5, ..belt_config() };
+    let config = RigidSceneConfig {
+        friction: 0.5,
+        ..belt_config()
+    };
     let (mut scene, id) = scene_with(config, kind);
     let theta = tilt.to_radians();
     let (r, zc) = (5.8e-3, com_height());
     let height = r * theta.sin() + zc * theta.cos() + 1e-6;
     let q = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), theta);
-    scene.add_body(id, Vector3::new(0.0, 0.0, height), q, Vector3::zeros(), Vector3::zeros()).unwrap();
+    scene
+        .add_body(
+            id,
+            Vector3::new(0.0, 0.0, height),
+            q,
+            Vector3::zeros(),
+            Vector3::zeros(),
+        )
+        .unwrap();
     let chunk = (1e-3 / scene.time_step()) as u64;
     let mut largest: f64 = 0.0;
     while scene.time() < seconds {
@@ -198,11 +302,17 @@ fn tilted_cartridge_falls_over_when_its_centre_of_mass_is_outside_the_base() {
         let (rocking, largest) = release_tilted(kind, 5.0, 0.4);
         println!("{kind}: from 20° → {fallen:.2}°; from 5° → {rocking:.2}°, largest {largest:.3}°");
         // lying on the floor the body cylinder is flat on it: the axis is horizontal
-        assert!((fallen - 90.0).abs() < 1.0, "{kind}: from 20° ended at {fallen}°");
+        assert!(
+            (fallen - 90.0).abs() < 1.0,
+            "{kind}: from 20° ended at {fallen}°"
+        );
         // inside the base it rocks from rim to rim (the rocking decays slowly: Housner's
         // coefficient for this slenderness is 0.95 per impact) but, starting from rest,
         // energy conservation bounds every later tilt by the first
-        assert!(largest < 5.0 + 0.05, "{kind}: from 5° it reached {largest}°");
+        assert!(
+            largest < 5.0 + 0.05,
+            "{kind}: from 5° it reached {largest}°"
+        );
     }
 }
 
@@ -210,10 +320,22 @@ fn tilted_cartridge_falls_over_when_its_centre_of_mass_is_outside_the_base() {
 /// speeds at 0.05 s and at the end, and the largest tilt, degrees.
 fn on_moving_belt(kind: &str, friction: f64, seconds: f64) -> (f64, f64, f64) {
     let belt = RigidSceneConfig::belt(Vector3::new(0.2, 0.0, 0.0)).unwrap();
-    let config = RigidSceneConfig { friction, planes: vec![belt], ..Default::default() };
+    let config = RigidSceneConfig {
+        friction,
+        planes: vec![belt],
+        ..Default::default()
+    };
     let (mut scene, id) = scene_with(config, kind);
     // placed resting on the belt (its weight's Hertz overlap is < 1 µm)
-    scene.add_body(id, Vector3::new(0.0, 0.0, com_height()), UnitQuaternion::identity(), Vector3::zeros(), Vector3::zeros()).unwrap();
+    scene
+        .add_body(
+            id,
+            Vector3::new(0.0, 0.0, com_height()),
+            UnitQuaternion::identity(),
+            Vector3::zeros(),
+            Vector3::zeros(),
+        )
+        .unwrap();
     let chunk = (1e-3 / scene.time_step()) as u64;
     let (mut early, mut largest) = (f64::NAN, 0.0_f64);
     while scene.time() < seconds {
@@ -234,7 +356,10 @@ fn belt_friction_accelerates_at_mu_g_and_tips_only_above_r_over_h() {
         let mu = 0.1;
         let (early, late, largest) = on_moving_belt(kind, mu, 0.3);
         println!("{kind} μ = {mu}: v(0.05 s) = {early:.4} m/s, v(0.3 s) = {late:.4} m/s, tilt ≤ {largest:.3}°");
-        assert!((early / (mu * 9.81 * 0.05) - 1.0).abs() < 0.1, "{kind}: v(0.05) = {early}");
+        assert!(
+            (early / (mu * 9.81 * 0.05) - 1.0).abs() < 0.1,
+            "{kind}: v(0.05) = {early}"
+        );
         assert!((late - 0.2).abs() < 0.005, "{kind}: final speed {late}");
         assert!(largest < 2.0, "{kind}: tilted {largest}°");
         let (_, _, tipped) = on_moving_belt(kind, 0.4, 0.3);
@@ -254,7 +379,15 @@ fn lying_on_slope(kind: &str, slope: f64, seconds: f64) -> f64 {
     };
     let (mut scene, id) = scene_with(config, kind);
     let lying = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), std::f64::consts::FRAC_PI_2);
-    scene.add_body(id, Vector3::new(0.0, 0.0, 5.8e-3 + 1e-7), lying, Vector3::zeros(), Vector3::zeros()).unwrap();
+    scene
+        .add_body(
+            id,
+            Vector3::new(0.0, 0.0, 5.8e-3 + 1e-7),
+            lying,
+            Vector3::zeros(),
+            Vector3::zeros(),
+        )
+        .unwrap();
     scene.run((seconds / scene.time_step()) as u64).unwrap();
     scene.bodies.velocity[0].x
 }
@@ -270,6 +403,9 @@ fn static_friction_holds_below_atan_mu_and_slides_at_the_coulomb_rate_above() {
         let expected = 9.81 * (a.sin() - 0.3 * a.cos()) * 0.1;
         println!("{kind}: speed at 10° {held:e} m/s, at 25° {sliding:.4} vs {expected:.4} m/s");
         assert!(held.abs() < 1e-4, "{kind}: creeps at {held} m/s");
-        assert!((sliding / expected - 1.0).abs() < 0.05, "{kind}: {sliding} vs {expected}");
+        assert!(
+            (sliding / expected - 1.0).abs() < 0.05,
+            "{kind}: {sliding} vs {expected}"
+        );
     }
 }

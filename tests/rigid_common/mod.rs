@@ -16,8 +16,14 @@ pub const CARTRIDGE_MASS: f64 = 0.004_941_142_604_323_21;
 pub fn cartridge_clump() -> (BeadClump, MassProperties) {
     let text = include_str!("../data/cartridge_clump_632.csv");
     let (mut centers, mut radii, mut masses) = (Vec::new(), Vec::new(), Vec::new());
-    for line in text.lines().filter(|l| !l.starts_with('#') && !l.trim().is_empty()) {
-        let v: Vec<f64> = line.split(',').map(|x| x.trim().parse::<f64>().unwrap()).collect();
+    for line in text
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
+    {
+        let v: Vec<f64> = line
+            .split(',')
+            .map(|x| x.trim().parse::<f64>().unwrap())
+            .collect();
         centers.push(Vector3::new(v[0], v[1], v[2]));
         radii.push(v[3]);
         masses.push(v[4]);
@@ -49,7 +55,11 @@ pub fn cartridge(kind: &str) -> (RigidShape, MassProperties) {
 
 /// Height of the centre of mass above the cartridge's bottom end, m (exact geometry).
 pub fn com_height() -> f64 {
-    RevolutionProfile::default_cartridge().mass_properties(GLASS_DENSITY).unwrap().center_of_mass.z
+    RevolutionProfile::default_cartridge()
+        .mass_properties(GLASS_DENSITY)
+        .unwrap()
+        .center_of_mass
+        .z
 }
 
 /// Angle between the body axis (body z) and world z, degrees.

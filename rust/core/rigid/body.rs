@@ -145,13 +145,20 @@ impl RigidBodies {
 
     /// Total linear momentum, kg·m/s.
     pub fn linear_momentum(&self) -> Vector3<f64> {
-        self.velocity.iter().zip(&self.mass).map(|(v, m)| v * *m).sum()
+        self.velocity
+            .iter()
+            .zip(&self.mass)
+            .map(|(v, m)| v * *m)
+            .sum()
     }
 
     /// Velocity of the material point at world position `point` of body `i`, m/s.
     #[inline]
     pub fn point_velocity(&self, i: usize, point: &Vector3<f64>) -> Vector3<f64> {
-        self.velocity[i] + self.angular_velocity_world(i).cross(&(point - self.position[i]))
+        self.velocity[i]
+            + self
+                .angular_velocity_world(i)
+                .cross(&(point - self.position[i]))
     }
 
     /// Half kick: v += h F/m and L_body += h Rᵀ τ, for time `h` (s).

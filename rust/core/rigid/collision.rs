@@ -57,15 +57,24 @@ impl Plane {
         surface_velocity: Vector3<f64>,
     ) -> Result<Self> {
         let length = normal.norm();
-        if length.is_nan() || length <= 0.0 || length.is_infinite()
-            || !point.iter().chain(surface_velocity.iter()).all(|v| v.is_finite())
+        if length.is_nan()
+            || length <= 0.0
+            || length.is_infinite()
+            || !point
+                .iter()
+                .chain(surface_velocity.iter())
+                .all(|v| v.is_finite())
         {
             return Err(DemfemError::ShapeMismatch {
                 field: "plane".into(),
                 detail: "point and surface velocity finite, normal finite and non-zero".into(),
             });
         }
-        Ok(Self { point, normal: normal / length, surface_velocity })
+        Ok(Self {
+            point,
+            normal: normal / length,
+            surface_velocity,
+        })
     }
 
     /// Signed distance of `x` (m) from the plane, positive on the free side, m.
@@ -86,7 +95,10 @@ pub struct BodyPose {
 impl BodyPose {
     fn to_parry(self) -> Pose {
         let (x, q) = (self.position, self.orientation.coords);
-        Pose::from_parts(Vector::new(x.x, x.y, x.z), Rotation::from_xyzw(q[0], q[1], q[2], q[3]))
+        Pose::from_parts(
+            Vector::new(x.x, x.y, x.z),
+            Rotation::from_xyzw(q[0], q[1], q[2], q[3]),
+        )
     }
 }
 
@@ -188,8 +200,9 @@ pub fn clump_clump_contacts(
         return;
     }
     let rot_a: Matrix3<f64> = pose_a.orientation.to_rotation_matrix().into_inner();
-    let rot_ab: Matrix3<f64> =
-        (pose_a.orientation.inverse() * pose_b.orientation).to_rotation_matrix().into_inner();
+    let rot_ab: Matrix3<f64> = (pose_a.orientation.inverse() * pose_b.orientation)
+        .to_rotation_matrix()
+        .into_inner();
     let t = rot_a.transpose() * between; // b's origin in a's frame
     let inside = |p: &Vector3<f64>, clump: &BeadClump, pad: f64| {
         (0..3).all(|k| p[k] >= clump.aabb_min[k] - pad && p[k] <= clump.aabb_max[k] + pad)
@@ -276,7 +289,9 @@ pub struct ExactContactCache {
 
 impl std::fmt::Debug for ExactContactCache {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("ExactContactCache").field("manifolds", &self.manifolds.len()).finish()
+        f.debug_struct("ExactContactCache")
+            .field("manifolds", &self.manifolds.len())
+            .finish()
     }
 }
 
@@ -300,8 +315,17 @@ fn manifold_contacts(
 ) -> Result<()> {
     let pos12 = pose1.inv_mul(pose2);
     DefaultQueryDispatcher
-        .contact_manifolds(&pos12, shape1, shape2, 0.0, &mut cache.manifolds, &mut cache.workspace)
-        .map_err(|_| DemfemError::Effect("parry3d has no contact manifold for this shape pair".into()))?;
+        .contact_manifolds(
+            &pos12,
+            shape1,
+            shape2,
+            0.0,
+            &mut cache.manifolds,
+            &mut cache.workspace,
+        )
+        .map_err(|_| {
+            DemfemError::Effect("parry3d has no contact manifold for this shape pair".into())
+        })?;
     let first_new = out.len();
     for manifold in &cache.manifolds {
         let sub1 = manifold.subshape_pos1().copied().unwrap_or(Pose::IDENTITY);
@@ -321,7 +345,11 @@ fn manifold_contacts(
             // the cone's polygon. Count it once, keeping the deeper report.
             let (r1, r2) = (radius1(manifold.subshape1), radius2(manifold.subshape2));
             let overlap = -contact.dist;
-            let reach = HULL_EDGE_ANGLE * [r1, r2].into_iter().filter(|r| r.is_finite()).fold(0.0, f64::max);
+            let reach = HULL_EDGE_ANGLE
+                * [r1, r2]
+                    .into_iter()
+                    .filter(|r| r.is_finite())
+                    .fold(0.0, f64::max);
             let feature_first = piece_feature(manifold.subshape1, contact.fid1.0);
             let feature_second = piece_feature(manifold.subshape2, contact.fid2.0);
             let same_contact = out[first_new..].iter().position(|c| {
@@ -366,7 +394,13 @@ fn piece_feature(piece: u32, feature: u32) -> u64 {
 }
 
 fn piece_radius(shape: &ExactShape) -> impl Fn(u32) -> f64 + '_ {
-    move |id| shape.piece_contact_radius.get(id as usize).copied().unwrap_or(f64::INFINITY)
+    move |id| {
+        shape
+            .piece_contact_radius
+            .get(id as usize)
+            .copied()
+            .unwrap_or(f64::INFINITY)
+    }
 }
 
 /// An exact shape against a plane (plane first), through parry's half-space manifolds

@@ -37,8 +37,10 @@ pub struct ContactMaterial {
 
 impl ContactMaterial {
     /// The paper's glass: E = 45 GPa, ν = 0.22.
-    pub const PAPER_GLASS: ContactMaterial =
-        ContactMaterial { young_modulus: 45e9, poisson_ratio: 0.22 };
+    pub const PAPER_GLASS: ContactMaterial = ContactMaterial {
+        young_modulus: 45e9,
+        poisson_ratio: 0.22,
+    };
 }
 
 /// Normal and tangential contact model shared by all contacts of a scene.
@@ -81,7 +83,13 @@ impl ContactModel {
         check_non_negative("friction", friction)?;
         let nu = body.poisson_ratio;
         let tangential_stiffness_ratio = 2.0 * (1.0 - nu) / (2.0 - nu);
-        Ok(Self { e_star_body_body, e_star_body_plane, damping_zeta, friction, tangential_stiffness_ratio })
+        Ok(Self {
+            e_star_body_body,
+            e_star_body_plane,
+            damping_zeta,
+            friction,
+            tangential_stiffness_ratio,
+        })
     }
 
     /// Force on the second object of `contact` (the first receives its opposite), N.
@@ -132,7 +140,11 @@ impl ContactModel {
             let magnitude = tangential.norm();
             if magnitude > cap {
                 tangential *= cap / magnitude;
-                turned = if k_t > 0.0 { -tangential / k_t } else { Vector3::zeros() };
+                turned = if k_t > 0.0 {
+                    -tangential / k_t
+                } else {
+                    Vector3::zeros()
+                };
             }
             *tangential_displacement = turned;
             force += tangential;
@@ -159,11 +171,22 @@ mod tests {
 
     #[test]
     fn static_normal_force_is_hertz() {
-        let model =
-            ContactModel::new(ContactMaterial::PAPER_GLASS, ContactMaterial::PAPER_GLASS, 1.0, 0.0)
-                .unwrap();
+        let model = ContactModel::new(
+            ContactMaterial::PAPER_GLASS,
+            ContactMaterial::PAPER_GLASS,
+            1.0,
+            0.0,
+        )
+        .unwrap();
         let f = model
-            .force(&contact(1e-6), &Vector3::zeros(), 1e-3, 20e9, &mut Vector3::zeros(), 1e-6)
+            .force(
+                &contact(1e-6),
+                &Vector3::zeros(),
+                1e-3,
+                20e9,
+                &mut Vector3::zeros(),
+                1e-6,
+            )
             .unwrap();
         let expected = 4.0 / 3.0 * (1e-3_f64).sqrt() * 20e9 * (1e-6_f64).powf(1.5);
         assert!((f.z / expected - 1.0).abs() < 1e-12 && f.x == 0.0 && f.y == 0.0);
@@ -171,18 +194,34 @@ mod tests {
 
     #[test]
     fn friction_is_capped_by_coulomb_and_sticks_below_it() {
-        let model =
-            ContactModel::new(ContactMaterial::PAPER_GLASS, ContactMaterial::PAPER_GLASS, 1.0, 0.3)
-                .unwrap();
+        let model = ContactModel::new(
+            ContactMaterial::PAPER_GLASS,
+            ContactMaterial::PAPER_GLASS,
+            1.0,
+            0.3,
+        )
+        .unwrap();
         let mut xi = Vector3::zeros();
-        let f = model.force(&contact(1e-6), &Vector3::new(10.0, 0.0, 0.0), 1e-3, 20e9, &mut xi, 1e-6).unwrap();
+        let f = model
+            .force(
+                &contact(1e-6),
+                &Vector3::new(10.0, 0.0, 0.0),
+                1e-3,
+                20e9,
+                &mut xi,
+                1e-6,
+            )
+            .unwrap();
         assert!((f.x + 0.3 * f.z).abs() < 1e-12 * f.z, "{f:?}");
         // at the cap the spring holds exactly the Coulomb force
-        let k_t = model.tangential_stiffness_ratio * 1.5 * 4.0 / 3.0 * (1e-3_f64).sqrt() * 20e9 * 1e-3;
+        let k_t =
+            model.tangential_stiffness_ratio * 1.5 * 4.0 / 3.0 * (1e-3_f64).sqrt() * 20e9 * 1e-3;
         assert!((xi.x * k_t - 0.3 * f.z).abs() < 1e-9 * f.z, "{xi:?}");
         // a small displacement below the cap: the spring force −k_t ξ, no sliding
         let mut xi = Vector3::new(1e-9, 0.0, 0.0);
-        let f = model.force(&contact(1e-6), &Vector3::zeros(), 1e-3, 20e9, &mut xi, 1e-6).unwrap();
+        let f = model
+            .force(&contact(1e-6), &Vector3::zeros(), 1e-3, 20e9, &mut xi, 1e-6)
+            .unwrap();
         assert!((f.x + k_t * 1e-9).abs() < 1e-9 * k_t * 1e-9, "{f:?}");
         assert_eq!(xi, Vector3::new(1e-9, 0.0, 0.0));
     }

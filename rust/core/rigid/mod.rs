@@ -20,4 +20,6 @@ pub use body::{RigidBodies, RigidBodyInit};
 pub use collision::{BodyPose, ContactPoint, Plane};
 pub use forces::{ContactMaterial, ContactModel};
 pub use scene::{RigidScene, RigidSceneConfig};
-pub use shape::{BeadClump, BoundingCapsule, ExactShape, MassProperties, RevolutionProfile, RigidShape};
+pub use shape::{
+    BeadClump, BoundingCapsule, ExactShape, MassProperties, RevolutionProfile, RigidShape,
+};

@@ -8,7 +8,7 @@
 //! limit is the Hertz contact duration t_c = 2.943 δ_max / v at the largest expected impact
 //! speed, for the smallest contact radius of any shape, the stiffer of the plane and the
 //! body–body moduli, and the smallest effective mass any surface point of a body can present
-//! (m_eff = 1/λ_max(𝟙/m + [r]×ᵀ I⁻¹ [r]×), the mass felt by a push at lever arm r), divided by
+//! (m_eff = 1/λ_max(𝟙/m + S(r)ᵀ I⁻¹ S(r)) with S(r) the cross-product matrix of r, the mass felt by a push at lever arm r), divided by
 //! [`STEPS_PER_CONTACT`]. A requested step above it is refused with
 //! [`DemfemError::UnstableTimeStep`].
 //!
@@ -202,10 +202,13 @@ impl RigidScene {
         velocity: Vector3<f64>,
         angular_velocity_body: Vector3<f64>,
     ) -> Result<usize> {
-        let (_, mass) = self.shapes.get(shape_id).ok_or_else(|| DemfemError::ShapeMismatch {
-            field: "shape_id".into(),
-            detail: format!("{shape_id} but only {} shapes exist", self.shapes.len()),
-        })?;
+        let (_, mass) = self
+            .shapes
+            .get(shape_id)
+            .ok_or_else(|| DemfemError::ShapeMismatch {
+                field: "shape_id".into(),
+                detail: format!("{shape_id} but only {} shapes exist", self.shapes.len()),
+            })?;
         let index = self.bodies.push(RigidBodyInit {
             position,
             orientation,
@@ -223,7 +226,10 @@ impl RigidScene {
     /// The stable time-step limit of the current bodies (see the module docs), s.
     pub fn time_step_limit(&self) -> Result<f64> {
         let mut limit = f64::INFINITY;
-        let e_star = self.model.e_star_body_body.max(self.model.e_star_body_plane);
+        let e_star = self
+            .model
+            .e_star_body_body
+            .max(self.model.e_star_body_plane);
         for &shape_id in &self.body_shape {
             let (shape, mass) = &self.shapes[shape_id];
             let m_eff = smallest_effective_mass(shape.surface_sample(), mass);
@@ -231,7 +237,10 @@ impl RigidScene {
             // against a plane: R* = r, m* = m_eff; against a twin body: R* = r/2, m* = m_eff/2
             for (r_star, m_star) in [
                 (radius, m_eff),
-                (effective_radius(radius, radius)?, effective_mass(m_eff, m_eff)?),
+                (
+                    effective_radius(radius, radius)?,
+                    effective_mass(m_eff, m_eff)?,
+                ),
             ] {
                 let k_h = hertz_stiffness(r_star, e_star)?;
                 let duration = hertz_contact_duration(k_h, m_star, self.max_expected_speed)?;
@@ -310,7 +319,9 @@ impl RigidScene {
         for i in 0..self.bodies.len() {
             let finite = self.bodies.position[i].iter().all(|v| v.is_finite())
                 && self.bodies.velocity[i].iter().all(|v| v.is_finite())
-                && self.bodies.angular_velocity_body[i].iter().all(|v| v.is_finite());
+                && self.bodies.angular_velocity_body[i]
+                    .iter()
+                    .all(|v| v.is_finite());
             if !finite {
                 return Err(DemfemError::Numerical(format!(
                     "body {i} has a non-finite state at t = {} s",
@@ -322,7 +333,10 @@ impl RigidScene {
     }
 
     fn pose(&self, i: usize) -> BodyPose {
-        BodyPose { position: self.bodies.position[i], orientation: self.bodies.orientation[i] }
+        BodyPose {
+            position: self.bodies.position[i],
+            orientation: self.bodies.orientation[i],
+        }
     }
 
     /// Gravity and every contact force and torque of the current configuration.
@@ -363,13 +377,24 @@ impl RigidScene {
                 for c in &contacts {
                     max_overlap = max_overlap.max(c.overlap);
                     let relative = self.bodies.point_velocity(i, &c.point) - plane.surface_velocity;
-                    let key = (plane_object(p) << 32 | i as u64, c.feature_first, c.feature_second);
+                    let key = (
+                        plane_object(p) << 32 | i as u64,
+                        c.feature_first,
+                        c.feature_second,
+                    );
                     let mut xi = if with_history {
                         previous.get(&key).copied().unwrap_or_else(Vector3::zeros)
                     } else {
                         Vector3::zeros()
                     };
-                    let f = self.model.force(c, &relative, m_star, self.model.e_star_body_plane, &mut xi, dt)?;
+                    let f = self.model.force(
+                        c,
+                        &relative,
+                        m_star,
+                        self.model.e_star_body_plane,
+                        &mut xi,
+                        dt,
+                    )?;
                     if with_history {
                         current.insert(key, xi);
                     }
@@ -382,7 +407,11 @@ impl RigidScene {
         order.clear();
         for i in 0..self.bodies.len() {
             let r = self.shapes[self.body_shape[i]].0.bounding_radius();
-            order.push((self.bodies.position[i].x - r, self.bodies.position[i].x + r, i));
+            order.push((
+                self.bodies.position[i].x - r,
+                self.bodies.position[i].x + r,
+                i,
+            ));
         }
         order.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
         for (k, &(_, upper, first_index)) in order.iter().enumerate() {
@@ -392,18 +421,28 @@ impl RigidScene {
                 }
                 let (a, b) = (first_index.min(second_index), first_index.max(second_index));
                 let (pa, pb) = (self.pose(a), self.pose(b));
-                let (shape_a, shape_b) =
-                    (&self.shapes[self.body_shape[a]].0, &self.shapes[self.body_shape[b]].0);
+                let (shape_a, shape_b) = (
+                    &self.shapes[self.body_shape[a]].0,
+                    &self.shapes[self.body_shape[b]].0,
+                );
                 let reach = shape_a.bounding_radius() + shape_b.bounding_radius();
                 let apart = (pb.position - pa.position).norm() >= reach
-                    || !capsules_overlap(&shape_a.bounding_capsule(), &pa, &shape_b.bounding_capsule(), &pb);
+                    || !capsules_overlap(
+                        &shape_a.bounding_capsule(),
+                        &pa,
+                        &shape_b.bounding_capsule(),
+                        &pb,
+                    );
                 if apart {
                     continue;
                 }
                 contacts.clear();
                 // the clump–exact pair is always computed with the clump first
                 let mut flipped = false;
-                match (&self.shapes[self.body_shape[a]].0, &self.shapes[self.body_shape[b]].0) {
+                match (
+                    &self.shapes[self.body_shape[a]].0,
+                    &self.shapes[self.body_shape[b]].0,
+                ) {
                     (RigidShape::Clump(ca), RigidShape::Clump(cb)) => clump_clump_contacts(
                         ca,
                         &pa,
@@ -433,13 +472,24 @@ impl RigidScene {
                     max_overlap = max_overlap.max(c.overlap);
                     let relative = self.bodies.point_velocity(second, &c.point)
                         - self.bodies.point_velocity(first, &c.point);
-                    let key = ((first as u64) << 32 | second as u64, c.feature_first, c.feature_second);
+                    let key = (
+                        (first as u64) << 32 | second as u64,
+                        c.feature_first,
+                        c.feature_second,
+                    );
                     let mut xi = if with_history {
                         previous.get(&key).copied().unwrap_or_else(Vector3::zeros)
                     } else {
                         Vector3::zeros()
                     };
-                    let f = self.model.force(c, &relative, m_star, self.model.e_star_body_body, &mut xi, dt)?;
+                    let f = self.model.force(
+                        c,
+                        &relative,
+                        m_star,
+                        self.model.e_star_body_body,
+                        &mut xi,
+                        dt,
+                    )?;
                     if with_history {
                         current.insert(key, xi);
                     }
@@ -450,7 +500,8 @@ impl RigidScene {
         }
         // manifolds of pairs that drifted apart are stale: forget them
         if !self.exact_caches.is_empty() {
-            self.exact_caches.retain(|_, cache| cache.last_used == evaluation);
+            self.exact_caches
+                .retain(|_, cache| cache.last_used == evaluation);
         }
         self.contacts = contacts;
         self.sweep_order = order;
@@ -475,7 +526,8 @@ fn smallest_effective_mass(points: &[Vector3<f64>], mass: &MassProperties) -> f6
     let mut smallest = mass.mass;
     for r in points {
         let cross = r.cross_matrix();
-        let inverse_mass = Matrix3::identity() / mass.mass + cross.transpose() * inverse_inertia * cross;
+        let inverse_mass =
+            Matrix3::identity() / mass.mass + cross.transpose() * inverse_inertia * cross;
         let largest = inverse_mass.symmetric_eigenvalues().max();
         if largest > 0.0 {
             smallest = smallest.min(1.0 / largest);
@@ -486,11 +538,22 @@ fn smallest_effective_mass(points: &[Vector3<f64>], mass: &MassProperties) -> f6
 
 /// True when the bounding capsules of two bodies overlap (a cheap, tight cull for long
 /// bodies: two upright cartridges 2 cm apart have overlapping bounding spheres, not capsules).
-fn capsules_overlap(a: &BoundingCapsule, pose_a: &BodyPose, b: &BoundingCapsule, pose_b: &BodyPose) -> bool {
+fn capsules_overlap(
+    a: &BoundingCapsule,
+    pose_a: &BodyPose,
+    b: &BoundingCapsule,
+    pose_b: &BodyPose,
+) -> bool {
     let axis_a = pose_a.orientation * Vector3::z();
     let axis_b = pose_b.orientation * Vector3::z();
-    let (a0, a1) = (pose_a.position + axis_a * a.z_min, pose_a.position + axis_a * a.z_max);
-    let (b0, b1) = (pose_b.position + axis_b * b.z_min, pose_b.position + axis_b * b.z_max);
+    let (a0, a1) = (
+        pose_a.position + axis_a * a.z_min,
+        pose_a.position + axis_a * a.z_max,
+    );
+    let (b0, b1) = (
+        pose_b.position + axis_b * b.z_min,
+        pose_b.position + axis_b * b.z_max,
+    );
     let reach = a.radius + b.radius;
     segment_distance_squared(&a0, &a1, &b0, &b1) < reach * reach
 }
@@ -517,7 +580,11 @@ fn segment_distance_squared(
         } else {
             let b = d1.dot(&d2);
             let denom = a * e - b * b;
-            let mut s = if denom > tiny { ((b * f - c * e) / denom).clamp(0.0, 1.0) } else { 0.0 };
+            let mut s = if denom > tiny {
+                ((b * f - c * e) / denom).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
             let mut t = (b * s + f) / e;
             if t < 0.0 {
                 t = 0.0;
@@ -541,7 +608,12 @@ mod tests {
         let z = Vector3::zeros();
         let ex = Vector3::x();
         // parallel segments 2 apart
-        let d = segment_distance_squared(&z, &ex, &Vector3::new(0.0, 2.0, 0.0), &Vector3::new(1.0, 2.0, 0.0));
+        let d = segment_distance_squared(
+            &z,
+            &ex,
+            &Vector3::new(0.0, 2.0, 0.0),
+            &Vector3::new(1.0, 2.0, 0.0),
+        );
         assert!((d - 4.0).abs() < 1e-15);
         // crossing skew segments 3 apart in z
         let d = segment_distance_squared(
@@ -552,7 +624,12 @@ mod tests {
         );
         assert!((d - 9.0).abs() < 1e-15);
         // end to end along a line
-        let d = segment_distance_squared(&z, &ex, &Vector3::new(3.0, 0.0, 0.0), &Vector3::new(4.0, 0.0, 0.0));
+        let d = segment_distance_squared(
+            &z,
+            &ex,
+            &Vector3::new(3.0, 0.0, 0.0),
+            &Vector3::new(4.0, 0.0, 0.0),
+        );
         assert!((d - 4.0).abs() < 1e-15);
     }
 }

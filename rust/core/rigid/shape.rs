@@ -59,11 +59,19 @@ impl RevolutionProfile {
             check_non_negative("r_in", r_in[k])?;
             check_positive("r_out", r_out[k])?;
             if r_in[k] >= r_out[k] {
-                return Err(DemfemError::invalid("r_in", r_in[k], &format!("< r_out = {}", r_out[k])));
+                return Err(DemfemError::invalid(
+                    "r_in",
+                    r_in[k],
+                    &format!("< r_out = {}", r_out[k]),
+                ));
             }
         }
         if z[z.len() - 1] <= z[0] {
-            return Err(DemfemError::invalid("z", z[z.len() - 1], "above the first station"));
+            return Err(DemfemError::invalid(
+                "z",
+                z[z.len() - 1],
+                "above the first station",
+            ));
         }
         Ok(Self { z, r_in, r_out })
     }
@@ -192,7 +200,11 @@ fn split_into_chunks(
             .iter()
             .map(|&m| (centers[m as usize] - center).norm() + radii[m as usize])
             .fold(0.0, f64::max);
-        chunks.push(BeadChunk { center, radius, members: offset..offset + members.len() });
+        chunks.push(BeadChunk {
+            center,
+            radius,
+            members: offset..offset + members.len(),
+        });
         return;
     }
     let axis = (hi - lo).imax();
@@ -249,7 +261,10 @@ impl BeadClump {
             inertia += Matrix3::identity() * (0.4 * m * r * r);
         }
         let diag = inertia.diagonal();
-        let off = inertia[(0, 1)].abs().max(inertia[(0, 2)].abs()).max(inertia[(1, 2)].abs());
+        let off = inertia[(0, 1)]
+            .abs()
+            .max(inertia[(0, 2)].abs())
+            .max(inertia[(1, 2)].abs());
         let (principal_inertia, principal_frame) = if off <= 1e-9 * diag.max() {
             (diag, UnitQuaternion::identity())
         } else {
@@ -266,7 +281,14 @@ impl BeadClump {
             .map(|c| principal_frame.inverse_transform_vector(&(c - com)))
             .collect();
         let clump = Self::from_body_frame(body_centers, radii.to_vec(), principal_frame);
-        Ok((clump, MassProperties { mass, center_of_mass: com, principal_inertia }))
+        Ok((
+            clump,
+            MassProperties {
+                mass,
+                center_of_mass: com,
+                principal_inertia,
+            },
+        ))
     }
 
     fn from_body_frame(
@@ -285,7 +307,11 @@ impl BeadClump {
         let max_bead_radius = radii.iter().cloned().fold(0.0, f64::max);
         let min_bead_radius = radii.iter().cloned().fold(f64::INFINITY, f64::min);
         // every bead centre lies within its radial distance of the axis segment at its own z
-        let mut capsule = BoundingCapsule { z_min: f64::INFINITY, z_max: f64::NEG_INFINITY, radius: 0.0 };
+        let mut capsule = BoundingCapsule {
+            z_min: f64::INFINITY,
+            z_max: f64::NEG_INFINITY,
+            radius: 0.0,
+        };
         for (c, &r) in centers.iter().zip(&radii) {
             capsule.z_min = capsule.z_min.min(c.z);
             capsule.z_max = capsule.z_max.max(c.z);
@@ -363,7 +389,11 @@ impl ExactShape {
     /// Build from a profile; `center_of_mass_z` (m, in the stations' frame) becomes the origin.
     pub fn from_profile(profile: &RevolutionProfile, center_of_mass_z: f64) -> Result<Self> {
         if !center_of_mass_z.is_finite() {
-            return Err(DemfemError::invalid("center_of_mass_z", center_of_mass_z, "finite"));
+            return Err(DemfemError::invalid(
+                "center_of_mass_z",
+                center_of_mass_z,
+                "finite",
+            ));
         }
         let y_to_z = Rotation::from_rotation_x(std::f64::consts::FRAC_PI_2);
         let mut pieces: Vec<(Pose, SharedShape)> = Vec::new();
@@ -466,7 +496,11 @@ impl RigidShape {
     pub fn min_contact_radius(&self) -> f64 {
         match self {
             RigidShape::Clump(c) => c.min_bead_radius,
-            RigidShape::Exact(e) => e.piece_contact_radius.iter().cloned().fold(f64::INFINITY, f64::min),
+            RigidShape::Exact(e) => e
+                .piece_contact_radius
+                .iter()
+                .cloned()
+                .fold(f64::INFINITY, f64::min),
         }
     }
 
@@ -500,8 +534,14 @@ mod tests {
     #[test]
     fn default_cartridge_mass_is_python_value() {
         // demfem.cartridge.Cartridge().mass = 0.00494114260432321 kg
-        let mp = RevolutionProfile::default_cartridge().mass_properties(2230.0).unwrap();
-        assert!((mp.mass / 0.004_941_142_604_323_21 - 1.0).abs() < 1e-12, "{}", mp.mass);
+        let mp = RevolutionProfile::default_cartridge()
+            .mass_properties(2230.0)
+            .unwrap();
+        assert!(
+            (mp.mass / 0.004_941_142_604_323_21 - 1.0).abs() < 1e-12,
+            "{}",
+            mp.mass
+        );
     }
 
     #[test]
