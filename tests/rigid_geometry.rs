@@ -306,3 +306,40 @@ fn culled_clump_pairs_find_every_bead_pair_at_any_orientation() {
         assert!(brute >= 3);
     }
 }
+
+#[test]
+fn bad_input_is_an_error_not_a_panic() {
+    assert!(Plane::new(Vector3::zeros(), Vector3::zeros(), Vector3::zeros()).is_err());
+    assert!(Plane::new(
+        Vector3::new(f64::NAN, 0.0, 0.0),
+        Vector3::z(),
+        Vector3::zeros()
+    )
+    .is_err());
+    let mut scene = RigidScene::new(RigidSceneConfig::default()).unwrap();
+    let (shape, mass) = cartridge("exact");
+    let id = scene.add_shape(shape, mass).unwrap();
+    let q = UnitQuaternion::identity();
+    let z = Vector3::zeros();
+    assert!(scene.add_body(id + 1, z, q, z, z).is_err());
+    assert!(scene
+        .add_body(id, Vector3::new(f64::NAN, 0.0, 0.0), q, z, z)
+        .is_err());
+    let bad = RigidSceneConfig {
+        restitution: 1.5,
+        ..Default::default()
+    };
+    assert!(RigidScene::new(bad).is_err());
+    let bad = RigidSceneConfig {
+        friction: -0.1,
+        ..Default::default()
+    };
+    assert!(RigidScene::new(bad).is_err());
+    let bad = RigidSceneConfig {
+        time_step: Some(0.0),
+        ..Default::default()
+    };
+    assert!(RigidScene::new(bad).is_err());
+    assert!(demfem::rigid::BeadClump::from_beads(&[Vector3::zeros()], &[0.0], &[1.0]).is_err());
+    assert!(demfem::rigid::BeadClump::from_beads(&[Vector3::zeros()], &[1.0], &[]).is_err());
+}

@@ -113,7 +113,8 @@ fn plane_object(plane: usize) -> u64 {
 /// Rigid bodies with shapes, planes and the step loop.
 #[derive(Debug)]
 pub struct RigidScene {
-    /// Body state.
+    /// Body state. After editing positions or velocities between runs, call
+    /// [`RigidScene::invalidate_forces`] so the next run starts from fresh forces.
     pub bodies: RigidBodies,
     shapes: Vec<(RigidShape, MassProperties)>,
     body_shape: Vec<usize>,
@@ -267,6 +268,11 @@ impl RigidScene {
             None => limit,
         };
         Ok(())
+    }
+
+    /// Mark the stored forces as stale (after editing `bodies` by hand).
+    pub fn invalidate_forces(&mut self) {
+        self.forces_current = false;
     }
 
     /// Time step in use, s.
