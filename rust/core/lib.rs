@@ -13,5 +13,6 @@ pub mod dem;
 pub mod error;
 pub mod fem;
 pub mod geometry;
+pub mod rigid;
 
 pub use error::{DemfemError, Result};

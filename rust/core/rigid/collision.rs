@@ -1,0 +1,530 @@
+//! Contact geometry of rigid shapes: pure geometry, no forces.
+//!
+//! Every function appends [`ContactPoint`]s in the world frame to an output vector. The normal
+//! points from the first object to the second, the overlap is positive, the point lies midway
+//! through the overlap. Bead contacts are computed by hand (they are sphere–sphere and
+//! sphere–plane tests); exact shapes go through parry3d-f64's contact manifolds, kept between
+//! steps in an [`ExactContactCache`] so parry can match features (persistent manifolds).
+
+use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+use parry3d_f64::math::{Pose, Rotation, Vector};
+use parry3d_f64::query::{
+    self, ContactManifold, ContactManifoldsWorkspace, DefaultQueryDispatcher,
+    PersistentQueryDispatcher,
+};
+use parry3d_f64::shape::{Ball, HalfSpace, Shape};
+
+use super::shape::{BeadClump, ExactShape};
+use crate::error::{DemfemError, Result};
+
+/// One contact point, world frame, SI.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactPoint {
+    /// Contact point, midway through the overlap, m.
+    pub point: Vector3<f64>,
+    /// Unit normal from the first object to the second.
+    pub normal: Vector3<f64>,
+    /// Overlap (interpenetration depth) > 0, m.
+    pub overlap: f64,
+    /// Curvature radius of the first surface at the contact, m (`inf` for a plane).
+    pub radius_first: f64,
+    /// Curvature radius of the second surface at the contact, m (`inf` for a plane).
+    pub radius_second: f64,
+    /// Feature of the first object that touches: the bead index for a clump, `piece << 32 |
+    /// parry feature id` for an exact shape, 0 for a plane or sphere. Keys friction history.
+    pub feature_first: u64,
+    /// Feature of the second object, as `feature_first`.
+    pub feature_second: u64,
+}
+
+/// An infinite plane bounding a solid half-space (the belt, a wall).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Plane {
+    /// A point of the plane, m.
+    pub point: Vector3<f64>,
+    /// Unit normal pointing out of the solid, into the free space.
+    pub normal: Vector3<f64>,
+    /// Velocity of the plane's surface (a belt moves tangentially), m/s.
+    pub surface_velocity: Vector3<f64>,
+}
+
+impl Plane {
+    /// A plane through `point` (m) with outward `normal` (any length > 0) whose surface
+    /// moves with `surface_velocity` (m/s).
+    pub fn new(
+        point: Vector3<f64>,
+        normal: Vector3<f64>,
+        surface_velocity: Vector3<f64>,
+    ) -> Result<Self> {
+        let length = normal.norm();
+        if length.is_nan()
+            || length <= 0.0
+            || length.is_infinite()
+            || !point
+                .iter()
+                .chain(surface_velocity.iter())
+                .all(|v| v.is_finite())
+        {
+            return Err(DemfemError::ShapeMismatch {
+                field: "plane".into(),
+                detail: "point and surface velocity finite, normal finite and non-zero".into(),
+            });
+        }
+        Ok(Self {
+            point,
+            normal: normal / length,
+            surface_velocity,
+        })
+    }
+
+    /// Signed distance of `x` (m) from the plane, positive on the free side, m.
+    pub fn signed_distance(&self, x: &Vector3<f64>) -> f64 {
+        self.normal.dot(&(x - self.point))
+    }
+}
+
+/// Position (m) and orientation (body → world) of a rigid body.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BodyPose {
+    /// Centre of mass, world, m.
+    pub position: Vector3<f64>,
+    /// Orientation, body → world.
+    pub orientation: UnitQuaternion<f64>,
+}
+
+impl BodyPose {
+    fn to_parry(self) -> Pose {
+        let (x, q) = (self.position, self.orientation.coords);
+        Pose::from_parts(
+            Vector::new(x.x, x.y, x.z),
+            Rotation::from_xyzw(q[0], q[1], q[2], q[3]),
+        )
+    }
+}
+
+fn to_nalgebra(v: Vector) -> Vector3<f64> {
+    Vector3::new(v.x, v.y, v.z)
+}
+
+/// Beads of a clump against a plane (plane first, clump second). One dot product per bead:
+/// the plane normal is taken into the body frame once; the bounding sphere culls the rest.
+pub fn clump_plane_contacts(
+    plane: &Plane,
+    clump: &BeadClump,
+    pose: &BodyPose,
+    out: &mut Vec<ContactPoint>,
+) {
+    let centre_distance = plane.signed_distance(&pose.position);
+    if centre_distance >= clump.bounding_radius {
+        return;
+    }
+    let normal_body = pose.orientation.inverse_transform_vector(&plane.normal);
+    // the lowest a bead can reach is the support of the box in the normal direction
+    for (i, (c, &r)) in clump.centers.iter().zip(&clump.radii).enumerate() {
+        let distance = centre_distance + normal_body.dot(c);
+        let overlap = r - distance;
+        if overlap > 0.0 {
+            let centre = pose.position + pose.orientation * c;
+            out.push(ContactPoint {
+                point: centre - plane.normal * (0.5 * (r + distance)),
+                normal: plane.normal,
+                overlap,
+                radius_first: f64::INFINITY,
+                radius_second: r,
+                feature_first: 0,
+                feature_second: i as u64,
+            });
+        }
+    }
+}
+
+/// Beads of a clump against a free sphere (clump first, sphere second).
+pub fn clump_sphere_contacts(
+    clump: &BeadClump,
+    pose: &BodyPose,
+    sphere_center: &Vector3<f64>,
+    sphere_radius: f64,
+    out: &mut Vec<ContactPoint>,
+) {
+    let rel = sphere_center - pose.position;
+    if rel.norm() >= clump.bounding_radius + sphere_radius {
+        return;
+    }
+    let local = pose.orientation.inverse_transform_vector(&rel);
+    for (i, (c, &r)) in clump.centers.iter().zip(&clump.radii).enumerate() {
+        let d = local - c;
+        let reach = r + sphere_radius;
+        let d2 = d.norm_squared();
+        if d2 < reach * reach && d2 > 0.0 {
+            let dist = d2.sqrt();
+            let n_local = d / dist;
+            let overlap = reach - dist;
+            let p_local = c + n_local * (r - 0.5 * overlap);
+            out.push(ContactPoint {
+                point: pose.position + pose.orientation * p_local,
+                normal: pose.orientation * n_local,
+                overlap,
+                radius_first: r,
+                radius_second: sphere_radius,
+                feature_first: i as u64,
+                feature_second: 0,
+            });
+        }
+    }
+}
+
+/// Reusable buffers for [`clump_clump_contacts`] (no allocation per step once warm).
+#[derive(Debug, Default, Clone)]
+pub struct ClumpPairScratch {
+    first: Vec<(u32, Vector3<f64>)>,
+    second: Vec<(f64, u32, Vector3<f64>)>,
+}
+
+/// Bead pairs of two clumps (a first, b second).
+///
+/// Bounding spheres cull the pair; then each clump keeps only the beads that lie inside the
+/// other's body-frame box (inflated by a bead radius), all expressed in a's body frame; the
+/// survivors of b are sorted along the axis where they spread most and each survivor of a
+/// scans only the window it can reach (sort and sweep): cost O(n log n + contacts) instead
+/// of 632².
+pub fn clump_clump_contacts(
+    a: &BeadClump,
+    pose_a: &BodyPose,
+    b: &BeadClump,
+    pose_b: &BodyPose,
+    scratch: &mut ClumpPairScratch,
+    out: &mut Vec<ContactPoint>,
+) {
+    let between = pose_b.position - pose_a.position;
+    if between.norm() >= a.bounding_radius + b.bounding_radius {
+        return;
+    }
+    let rot_a: Matrix3<f64> = pose_a.orientation.to_rotation_matrix().into_inner();
+    let rot_ab: Matrix3<f64> = (pose_a.orientation.inverse() * pose_b.orientation)
+        .to_rotation_matrix()
+        .into_inner();
+    let t = rot_a.transpose() * between; // b's origin in a's frame
+    let inside = |p: &Vector3<f64>, clump: &BeadClump, pad: f64| {
+        (0..3).all(|k| p[k] >= clump.aabb_min[k] - pad && p[k] <= clump.aabb_max[k] + pad)
+    };
+    scratch.first.clear();
+    scratch.second.clear();
+    let mut lo = Vector3::repeat(f64::INFINITY);
+    let mut hi = Vector3::repeat(f64::NEG_INFINITY);
+    // only the bead groups whose spheres reach the other body's box are opened
+    for chunk in &b.chunks {
+        if !inside(&(t + rot_ab * chunk.center), a, chunk.radius) {
+            continue;
+        }
+        for &j in &b.chunk_members[chunk.members.clone()] {
+            let in_a = t + rot_ab * b.centers[j as usize];
+            if inside(&in_a, a, b.radii[j as usize]) {
+                lo = lo.inf(&in_a);
+                hi = hi.sup(&in_a);
+                scratch.second.push((0.0, j, in_a));
+            }
+        }
+    }
+    if scratch.second.is_empty() {
+        return;
+    }
+    let rot_ba = rot_ab.transpose();
+    for chunk in &a.chunks {
+        if !inside(&(rot_ba * (chunk.center - t)), b, chunk.radius) {
+            continue;
+        }
+        for &i in &a.chunk_members[chunk.members.clone()] {
+            let c = a.centers[i as usize];
+            if inside(&(rot_ba * (c - t)), b, a.radii[i as usize]) {
+                scratch.first.push((i, c));
+            }
+        }
+    }
+    let spread = hi - lo;
+    let axis = spread.imax();
+    for entry in scratch.second.iter_mut() {
+        entry.0 = entry.2[axis];
+    }
+    scratch.second.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
+    let reach_max = a.max_bead_radius + b.max_bead_radius;
+    for &(i, ca) in &scratch.first {
+        let ra = a.radii[i as usize];
+        let key = ca[axis];
+        let start = scratch.second.partition_point(|e| e.0 < key - reach_max);
+        for &(kb, j, cb) in &scratch.second[start..] {
+            if kb > key + reach_max {
+                break;
+            }
+            let rb = b.radii[j as usize];
+            let d = cb - ca;
+            let d2 = d.norm_squared();
+            let reach = ra + rb;
+            if d2 < reach * reach && d2 > 0.0 {
+                let dist = d2.sqrt();
+                let n_local = d / dist;
+                let overlap = reach - dist;
+                let p_local = ca + n_local * (ra - 0.5 * overlap);
+                out.push(ContactPoint {
+                    point: pose_a.position + rot_a * p_local,
+                    normal: rot_a * n_local,
+                    overlap,
+                    radius_first: ra,
+                    radius_second: rb,
+                    feature_first: i as u64,
+                    feature_second: j as u64,
+                });
+            }
+        }
+    }
+}
+
+/// Persistent parry contact manifolds of one pair of objects, kept from step to step.
+#[derive(Default)]
+pub struct ExactContactCache {
+    manifolds: Vec<ContactManifold<(), ()>>,
+    workspace: Option<ContactManifoldsWorkspace>,
+    /// Force evaluation that last used this cache (the scene drops caches it did not use).
+    pub(crate) last_used: u64,
+}
+
+impl std::fmt::Debug for ExactContactCache {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ExactContactCache")
+            .field("manifolds", &self.manifolds.len())
+            .finish()
+    }
+}
+
+/// Contacts of different pieces closer than this angle times the piece radius (one edge of
+/// the 32-gon of a cone piece) are one contact, rad.
+const HULL_EDGE_ANGLE: f64 = 2.0 * std::f64::consts::PI / 32.0;
+
+/// Radius of the piece `id` of an exact shape; `inf` for a plane, the ball's own for a ball.
+type RadiusOf<'a> = &'a dyn Fn(u32) -> f64;
+
+#[allow(clippy::too_many_arguments)]
+fn manifold_contacts(
+    pose1: &Pose,
+    shape1: &dyn Shape,
+    radius1: RadiusOf<'_>,
+    pose2: &Pose,
+    shape2: &dyn Shape,
+    radius2: RadiusOf<'_>,
+    cache: &mut ExactContactCache,
+    out: &mut Vec<ContactPoint>,
+) -> Result<()> {
+    let pos12 = pose1.inv_mul(pose2);
+    DefaultQueryDispatcher
+        .contact_manifolds(
+            &pos12,
+            shape1,
+            shape2,
+            0.0,
+            &mut cache.manifolds,
+            &mut cache.workspace,
+        )
+        .map_err(|_| {
+            DemfemError::Effect("parry3d has no contact manifold for this shape pair".into())
+        })?;
+    let first_new = out.len();
+    for manifold in &cache.manifolds {
+        let sub1 = manifold.subshape_pos1().copied().unwrap_or(Pose::IDENTITY);
+        let sub2 = manifold.subshape_pos2().copied().unwrap_or(Pose::IDENTITY);
+        let frame1 = *pose1 * sub1;
+        let frame2 = *pose2 * sub2;
+        let normal = to_nalgebra(frame1.rotation * manifold.local_n1);
+        for contact in &manifold.points {
+            if contact.dist >= 0.0 {
+                continue;
+            }
+            let p1 = to_nalgebra(frame1 * contact.local_p1);
+            let p2 = to_nalgebra(frame2 * contact.local_p2);
+            let point = 0.5 * (p1 + p2);
+            // Adjacent pieces of a compound share their boundary circle (body cylinder and
+            // shoulder cone): both report the same physical contact there, up to one edge of
+            // the cone's polygon. Count it once, keeping the deeper report.
+            let (r1, r2) = (radius1(manifold.subshape1), radius2(manifold.subshape2));
+            let overlap = -contact.dist;
+            let reach = HULL_EDGE_ANGLE
+                * [r1, r2]
+                    .into_iter()
+                    .filter(|r| r.is_finite())
+                    .fold(0.0, f64::max);
+            let feature_first = piece_feature(manifold.subshape1, contact.fid1.0);
+            let feature_second = piece_feature(manifold.subshape2, contact.fid2.0);
+            let same_contact = out[first_new..].iter().position(|c| {
+                ((c.feature_first >> 32) as u32 != manifold.subshape1
+                    || (c.feature_second >> 32) as u32 != manifold.subshape2)
+                    && (c.point - point).norm() < reach
+                    && c.normal.dot(&normal) > 0.999
+            });
+            if let Some(k) = same_contact {
+                let existing = &mut out[first_new + k];
+                if overlap > existing.overlap * (1.0 + 1e-9) {
+                    *existing = ContactPoint {
+                        point,
+                        normal,
+                        overlap,
+                        radius_first: r1,
+                        radius_second: r2,
+                        feature_first,
+                        feature_second,
+                    };
+                }
+                continue;
+            }
+            out.push(ContactPoint {
+                point,
+                normal,
+                overlap: -contact.dist,
+                radius_first: r1,
+                radius_second: r2,
+                feature_first,
+                feature_second,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Feature key of an exact-shape contact: piece in the high half, parry feature id below.
+#[inline]
+fn piece_feature(piece: u32, feature: u32) -> u64 {
+    ((piece as u64) << 32) | feature as u64
+}
+
+fn piece_radius(shape: &ExactShape) -> impl Fn(u32) -> f64 + '_ {
+    move |id| {
+        shape
+            .piece_contact_radius
+            .get(id as usize)
+            .copied()
+            .unwrap_or(f64::INFINITY)
+    }
+}
+
+/// An exact shape against a plane (plane first), through parry's half-space manifolds
+/// (a cylinder cap gives four rim points, its side a segment's two ends).
+pub fn exact_plane_contacts(
+    plane: &Plane,
+    shape: &ExactShape,
+    pose: &BodyPose,
+    cache: &mut ExactContactCache,
+    out: &mut Vec<ContactPoint>,
+) -> Result<()> {
+    if plane.signed_distance(&pose.position) >= shape.bounding_radius {
+        cache.manifolds.clear();
+        return Ok(());
+    }
+    let n = plane.normal;
+    let half_space = HalfSpace::new(Vector::new(n.x, n.y, n.z));
+    let p = plane.point;
+    let plane_pose = Pose::from_translation(Vector::new(p.x, p.y, p.z));
+    let flat = |_: u32| f64::INFINITY;
+    manifold_contacts(
+        &plane_pose,
+        &half_space,
+        &flat,
+        &pose.to_parry(),
+        &shape.compound,
+        &piece_radius(shape),
+        cache,
+        out,
+    )
+}
+
+/// Two exact shapes (a first, b second) through parry's compound–compound manifolds.
+pub fn exact_exact_contacts(
+    a: &ExactShape,
+    pose_a: &BodyPose,
+    b: &ExactShape,
+    pose_b: &BodyPose,
+    cache: &mut ExactContactCache,
+    out: &mut Vec<ContactPoint>,
+) -> Result<()> {
+    if (pose_b.position - pose_a.position).norm() >= a.bounding_radius + b.bounding_radius {
+        cache.manifolds.clear();
+        return Ok(());
+    }
+    manifold_contacts(
+        &pose_a.to_parry(),
+        &a.compound,
+        &piece_radius(a),
+        &pose_b.to_parry(),
+        &b.compound,
+        &piece_radius(b),
+        cache,
+        out,
+    )
+}
+
+/// An exact shape against a free sphere (shape first, sphere second).
+pub fn exact_sphere_contacts(
+    shape: &ExactShape,
+    pose: &BodyPose,
+    sphere_center: &Vector3<f64>,
+    sphere_radius: f64,
+    cache: &mut ExactContactCache,
+    out: &mut Vec<ContactPoint>,
+) -> Result<()> {
+    if (sphere_center - pose.position).norm() >= shape.bounding_radius + sphere_radius {
+        cache.manifolds.clear();
+        return Ok(());
+    }
+    let ball = Ball::new(sphere_radius);
+    let c = sphere_center;
+    let ball_pose = Pose::from_translation(Vector::new(c.x, c.y, c.z));
+    let own = move |_: u32| sphere_radius;
+    manifold_contacts(
+        &pose.to_parry(),
+        &shape.compound,
+        &piece_radius(shape),
+        &ball_pose,
+        &ball,
+        &own,
+        cache,
+        out,
+    )
+}
+
+/// Beads of a clump against an exact shape (clump first): each bead within reach of the
+/// shape's bounding sphere is a parry ball queried against the compound.
+pub fn clump_exact_contacts(
+    clump: &BeadClump,
+    pose_clump: &BodyPose,
+    shape: &ExactShape,
+    pose_shape: &BodyPose,
+    out: &mut Vec<ContactPoint>,
+) -> Result<()> {
+    let between = pose_shape.position - pose_clump.position;
+    if between.norm() >= clump.bounding_radius + shape.bounding_radius {
+        return Ok(());
+    }
+    let local_shape_centre = pose_clump.orientation.inverse_transform_vector(&between);
+    let shape_pose = pose_shape.to_parry();
+    for (i, (c, &r)) in clump.centers.iter().zip(&clump.radii).enumerate() {
+        if (c - local_shape_centre).norm() >= shape.bounding_radius + r {
+            continue;
+        }
+        let centre = pose_clump.position + pose_clump.orientation * c;
+        let ball_pose = Pose::from_translation(Vector::new(centre.x, centre.y, centre.z));
+        let found = query::contact(&ball_pose, &Ball::new(r), &shape_pose, &shape.compound, 0.0)
+            .map_err(|_| DemfemError::Effect("parry3d has no ball–compound contact".into()))?;
+        if let Some(contact) = found {
+            if contact.dist < 0.0 {
+                let p1 = to_nalgebra(contact.point1);
+                let p2 = to_nalgebra(contact.point2);
+                out.push(ContactPoint {
+                    point: 0.5 * (p1 + p2),
+                    normal: to_nalgebra(contact.normal1),
+                    overlap: -contact.dist,
+                    radius_first: r,
+                    radius_second: piece_radius(shape)(contact.subshape2),
+                    feature_first: i as u64,
+                    feature_second: piece_feature(contact.subshape2, 0),
+                });
+            }
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,25 @@
+//! Rigid bodies for full-shape cartridges: a cartridge as a rigid clump of beads or as an
+//! exact shape through parry3d-f64, their contact geometry and forces, and a small stepping
+//! loop for scenes of rigid bodies on a belt between walls.
+//!
+//! - [`body`]: state (structure of arrays) and the symplectic rigid-body integrator;
+//! - [`shape`]: the body of revolution, the bead clump and the exact parry compound;
+//! - [`collision`]: contact points between shapes, planes and spheres (pure geometry);
+//! - [`forces`]: Hertz + Tsuji normal force and Mindlin–Coulomb friction per contact;
+//! - [`scene`]: gravity, belt, walls, time-step limit and the step loop.
+//!
+//! Self-contained: nothing here depends on the sphere DEM in `dem/` or `geometry/`.
+
+pub mod body;
+pub mod collision;
+pub mod forces;
+pub mod scene;
+pub mod shape;
+
+pub use body::{RigidBodies, RigidBodyInit};
+pub use collision::{BodyPose, ContactPoint, Plane};
+pub use forces::{ContactMaterial, ContactModel};
+pub use scene::{RigidScene, RigidSceneConfig};
+pub use shape::{
+    BeadClump, BoundingCapsule, ExactShape, MassProperties, RevolutionProfile, RigidShape,
+};
