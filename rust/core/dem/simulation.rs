@@ -602,8 +602,8 @@ fn wall_kernel<const E: u16>(
         s.onset_normal_speed = v_n;
         s.onset_tangential_speed = v_t.length();
     }
-    let k = s.k;
-    let (f_el, c_n, k_t) = law_at::<E>(&k, c.model, c.laws, c.effects, overlap);
+    let (f_el, c_n, k_t) = law_at::<E>(&s.k, c.model, c.laws, c.effects, overlap);
+    let (ct_ratio, mu, law) = (s.k.ct_ratio, s.k.mu, s.k.law as usize);
     let mut f_n = f_el + c_n * v_n;
     if c.clamp && f_n < 0.0 {
         f_n = 0.0;
@@ -616,8 +616,8 @@ fn wall_kernel<const E: u16>(
             n,
             v_t,
             k_t,
-            c_n * k.ct_ratio,
-            k.mu * f_n.max(0.0),
+            c_n * ct_ratio,
+            mu * f_n.max(0.0),
             c.dt,
         );
         force += f_t;
@@ -626,7 +626,7 @@ fn wall_kernel<const E: u16>(
         }
     }
     if on::<E>(c.effects, Effect::RollingResistance) {
-        let law = &c.laws[k.law as usize];
+        let law = &c.laws[law];
         let w_roll = w - w.dot(n) * n;
         let w_mag = w_roll.length();
         if w_mag > 0.0 {
@@ -669,16 +669,29 @@ fn particle_chunk<const E: u16>(
     // nine finiteness tests, checked once per chunk
     let mut probe = Vec3::ZERO;
     let mut wall_onsets = 0u32;
-    for k in 0..position.len() {
+    // every per-particle array cut to this chunk once, so the loop indexes by k < len
+    // without further bounds checks
+    let len = position.len();
+    let last = first + len;
+    let alive = &c.alive[first..last];
+    let radius = &c.radius[first..last];
+    let inv_mass = &c.inv_mass[first..last];
+    let inv_inertia = &c.inv_inertia[first..last];
+    let reference = &c.reference_position[first..last];
+    let offset = &c.csr_offset[first..=last];
+    let (velocity, omega) = (&mut velocity[..len], &mut omega[..len]);
+    let (force_sum, coordination) = (&mut force_sum[..len], &mut coordination[..len]);
+    let wall_coordination = &mut wall_coordination[..len];
+    let stride = c.wall_stride;
+    for (k, slots) in slots.chunks_exact_mut(stride).take(len).enumerate() {
         let i = first + k;
-        if !c.alive[i] {
+        if !alive[k] {
             continue;
         }
         let mut f = Vec3::ZERO;
         let mut t = Vec3::ZERO;
         let mut z = 0u32;
-        let (a, b) = (c.csr_offset[i] as usize, c.csr_offset[i + 1] as usize);
-        for &e in &c.csr_entry[a..b] {
+        for &e in &c.csr_entry[offset[k] as usize..offset[k + 1] as usize] {
             let p = &c.pair_out[(e >> 1) as usize];
             if !(p.overlap > 0.0) {
                 continue;
@@ -690,7 +703,7 @@ fn particle_chunk<const E: u16>(
                 f -= p.force;
             }
             if rotation {
-                let arm = c.radius[i] - 0.5 * p.overlap;
+                let arm = radius[k] - 0.5 * p.overlap;
                 t += arm * p.torque_per_arm;
                 if rolling {
                     let m = c.pairs[(e >> 1) as usize].rolling_torque;
@@ -704,8 +717,7 @@ fn particle_chunk<const E: u16>(
         }
         let (x, v, w) = (position[k], velocity[k], omega[k]);
         let mut zw = 0u32;
-        let stride = c.wall_stride;
-        for s in &mut slots[k * stride..(k + 1) * stride] {
+        for s in slots.iter_mut() {
             if s.wall == NO_WALL {
                 break;
             }
@@ -722,12 +734,12 @@ fn particle_chunk<const E: u16>(
         force_sum[k] = f;
         coordination[k] = z;
         wall_coordination[k] = zw;
-        let v_new = v + (f * c.inv_mass[i] + gravity) * c.dt;
+        let v_new = v + (f * inv_mass[k] + gravity) * c.dt;
         let x_new = x + v_new * c.dt;
         velocity[k] = v_new;
         position[k] = x_new;
         if rotation {
-            let mut w_new = w + t * (c.inv_inertia[i] * c.dt);
+            let mut w_new = w + t * (inv_inertia[k] * c.dt);
             if planar {
                 w_new.x = 0.0;
                 w_new.y = 0.0;
@@ -736,7 +748,11 @@ fn particle_chunk<const E: u16>(
             probe += w_new * 0.0;
         }
         probe += (x_new + v_new) * 0.0;
-        max_disp2 = max_disp2.max((x_new - c.reference_position[i]).length_squared());
+        // a NaN displacement is caught by the probe; no NaN-aware max needed
+        let disp2 = (x_new - reference[k]).length_squared();
+        if disp2 > max_disp2 {
+            max_disp2 = disp2;
+        }
     }
     (max_disp2, !probe.is_finite(), wall_onsets)
 }
