@@ -3,11 +3,19 @@
 //!
 //! One step (leapfrog, velocities stored at half steps):
 //! 1. rebuild the Verlet lists if a particle or a wall moved more than half the skin;
-//! 2. **pair phase** — for every candidate pair, in parallel chunks, the contact force from
-//!    x(t) and v(t − Δt/2) is written into the pair's own slot (no shared accumulator);
+//! 2. **force phase** — for every candidate pair and every particle–wall slot, in parallel
+//!    chunks (pairs and walls side by side in one `rayon::join`), the contact force from x(t)
+//!    and v(t − Δt/2) is written into the pair's or slot's own record (no shared accumulator);
 //! 3. **particle phase** — for every particle, in parallel chunks: the pair forces are gathered
-//!    in the fixed order of the particle's pair list, the particle's own wall contacts are
-//!    computed, and the particle is advanced: v += F/m Δt, x += v Δt, ω += T/I Δt.
+//!    in the fixed order of the particle's pair list, then its wall slots' forces in slot
+//!    order, and the particle is advanced: v += F/m Δt, x += v Δt, ω += T/I Δt.
+//!
+//! The kernels are monomorphised over the effect set (const generic `E`): the anchor table's
+//! set (with and without `planar`) gets a specialised step without effect tests in the inner
+//! loops, any other set runs the generic one. Law constants that depend only on the two bodies
+//! (E*, G*, √R*, m*, damping prefactor, friction) are derived once per neighbour-list rebuild
+//! (`ContactConst`), so a contact costs three square roots (distance, √δ, δ^{1/4}) and one
+//! division, plus a square root and two divisions in gross sliding.
 //!
 //! Every floating-point sum is taken in an order fixed by the lists, never by the thread
 //! schedule, so results are bitwise identical for any thread count; the step synchronises
@@ -130,6 +138,8 @@ pub(crate) struct WallContact {
     pub(crate) onset: bool,
     pub(crate) history: Vec3,
     pub(crate) force: Vec3,
+    /// Torque on the particle, N·m (zero when not in contact).
+    pub(crate) torque: Vec3,
     pub(crate) normal: Vec3,
     pub(crate) point: Vec3,
     pub(crate) overlap: f64,
@@ -147,6 +157,7 @@ impl Default for WallContact {
             onset: false,
             history: Vec3::ZERO,
             force: Vec3::ZERO,
+            torque: Vec3::ZERO,
             normal: Vec3::ZERO,
             point: Vec3::ZERO,
             overlap: 0.0,
@@ -263,6 +274,24 @@ struct PairCtx<'a> {
     dt: f64,
 }
 
+/// Read-only context of the wall kernels (run in the force phase, next to the pairs).
+struct WallCtx<'a> {
+    position: &'a [Vec3],
+    velocity: &'a [Vec3],
+    omega: &'a [Vec3],
+    alive: &'a [bool],
+    radius: &'a [f64],
+    inertia: &'a [f64],
+    walls: &'a [Wall],
+    wall_state: &'a [WallState],
+    laws: &'a [PairLaw],
+    model: ContactModel,
+    effects: EffectSet,
+    clamp: bool,
+    dt: f64,
+    wall_stride: usize,
+}
+
 /// Read-only context of the particle phase.
 struct ParticleCtx<'a> {
     pairs: &'a [PairContact],
@@ -271,17 +300,11 @@ struct ParticleCtx<'a> {
     csr_entry: &'a [u32],
     radius: &'a [f64],
     inv_mass: &'a [f64],
-    inertia: &'a [f64],
     inv_inertia: &'a [f64],
     alive: &'a [bool],
     reference_position: &'a [Vec3],
-    walls: &'a [Wall],
-    wall_state: &'a [WallState],
-    laws: &'a [PairLaw],
-    model: ContactModel,
     effects: EffectSet,
     gravity: Vec3,
-    clamp: bool,
     dt: f64,
     wall_stride: usize,
 }
@@ -553,7 +576,8 @@ fn wall_hit(wall: &Wall, x: Vec3, offset: Vec3, r: f64) -> Option<(Vec3, Vec3, f
     }
 }
 
-/// Force of one particle–wall slot on particle i; returns (force, torque) and flags onset.
+/// Force and torque of one particle–wall slot on particle i, stored in the slot with the
+/// contact state; flags onset.
 #[inline(always)]
 fn wall_kernel<const E: u16>(
     s: &mut WallContact,
@@ -561,8 +585,8 @@ fn wall_kernel<const E: u16>(
     x: Vec3,
     v: Vec3,
     w: Vec3,
-    c: &ParticleCtx<'_>,
-) -> (Vec3, Vec3) {
+    c: &WallCtx<'_>,
+) {
     let wall = &c.walls[s.wall as usize];
     let ws = c.wall_state[s.wall as usize];
     let r = c.radius[i];
@@ -573,11 +597,12 @@ fn wall_kernel<const E: u16>(
                 s.active = false;
                 s.history = Vec3::ZERO;
                 s.force = Vec3::ZERO;
+                s.torque = Vec3::ZERO;
                 s.overlap = 0.0;
                 s.normal_force = 0.0;
             }
             s.onset = false;
-            return (Vec3::ZERO, Vec3::ZERO);
+            return;
         }
     };
     let n = -out_normal; // from the particle towards the wall
@@ -635,11 +660,29 @@ fn wall_kernel<const E: u16>(
         }
     }
     s.force = force;
+    s.torque = torque;
     s.normal = n;
     s.point = point;
     s.overlap = overlap;
     s.normal_force = f_n;
-    (force, torque)
+}
+
+/// Wall kernels of the particles of one chunk starting at `first` (their slots).
+#[inline(always)]
+fn wall_chunk<const E: u16>(c: &WallCtx<'_>, first: usize, slots: &mut [WallContact]) {
+    for (k, slots) in slots.chunks_exact_mut(c.wall_stride).enumerate() {
+        let i = first + k;
+        if !c.alive[i] {
+            continue;
+        }
+        let (x, v, w) = (c.position[i], c.velocity[i], c.omega[i]);
+        for s in slots.iter_mut() {
+            if s.wall == NO_WALL {
+                break;
+            }
+            wall_kernel::<E>(s, i, x, v, w, c);
+        }
+    }
 }
 
 /// Particle phase on one chunk of particles starting at `first`. Returns (largest squared
@@ -654,7 +697,7 @@ fn particle_chunk<const E: u16>(
     force_sum: &mut [Vec3],
     coordination: &mut [u32],
     wall_coordination: &mut [u32],
-    slots: &mut [WallContact],
+    slots: &[WallContact],
 ) -> (f64, bool, u32) {
     let rotation = on::<E>(c.effects, Effect::Rotation);
     let rolling = on::<E>(c.effects, Effect::RollingResistance);
@@ -683,8 +726,7 @@ fn particle_chunk<const E: u16>(
     let (force_sum, coordination) = (&mut force_sum[..len], &mut coordination[..len]);
     let wall_coordination = &mut wall_coordination[..len];
     let stride = c.wall_stride;
-    for (k, slots) in slots.chunks_exact_mut(stride).take(len).enumerate() {
-        let i = first + k;
+    for (k, slots) in slots.chunks_exact(stride).take(len).enumerate() {
         if !alive[k] {
             continue;
         }
@@ -715,22 +757,21 @@ fn particle_chunk<const E: u16>(
             // upright cartridges cannot climb on each other: particle forces act in the plane
             f.z = 0.0;
         }
-        let (x, v, w) = (position[k], velocity[k], omega[k]);
         let mut zw = 0u32;
-        for s in slots.iter_mut() {
+        for s in slots.iter() {
             if s.wall == NO_WALL {
                 break;
             }
-            let (fw, tw) = wall_kernel::<E>(s, i, x, v, w, c);
             if s.active {
                 zw += 1;
                 if s.onset {
                     wall_onsets += 1;
                 }
-                f += fw;
-                t += tw;
+                f += s.force;
+                t += s.torque;
             }
         }
+        let (x, v, w) = (position[k], velocity[k], omega[k]);
         force_sum[k] = f;
         coordination[k] = z;
         wall_coordination[k] = zw;
@@ -1144,9 +1185,10 @@ impl Simulation {
 
     /// Pair phase and particle phase of one step, specialised on the effect set `E`.
     fn force_and_advance<const E: u16>(&mut self, parallel: bool) {
-        // ---- pair phase
+        let stride = self.wall_stride;
+        // ---- force phase: every pair and every wall slot writes its own record only
         {
-            let ctx = PairCtx {
+            let pair_ctx = PairCtx {
                 position: &self.position,
                 velocity: &self.velocity,
                 omega: &self.omega,
@@ -1158,6 +1200,22 @@ impl Simulation {
                 clamp: self.clamp,
                 dt: self.dt,
             };
+            let wall_ctx = WallCtx {
+                position: &self.position,
+                velocity: &self.velocity,
+                omega: &self.omega,
+                alive: &self.alive,
+                radius: &self.radius,
+                inertia: &self.inertia,
+                walls: &self.walls,
+                wall_state: &self.wall_state,
+                laws: &self.laws,
+                model: self.model,
+                effects: self.effects,
+                clamp: self.clamp,
+                dt: self.dt,
+                wall_stride: stride,
+            };
             let kernel = |((chunk, out), konst): (
                 (&mut [PairContact], &mut [PairOut]),
                 &[ContactConst],
@@ -1165,32 +1223,43 @@ impl Simulation {
              -> u32 {
                 let mut onsets = 0u32;
                 for ((p, o), k) in chunk.iter_mut().zip(out.iter_mut()).zip(konst) {
-                    onsets += pair_kernel::<E>(p, k, o, &ctx) as u32;
+                    onsets += pair_kernel::<E>(p, k, o, &pair_ctx) as u32;
                 }
                 onsets
             };
+            let (pairs, pair_out, pair_const) =
+                (&mut self.pairs, &mut self.pair_out, &self.pair_const);
+            let (onsets, slots) = (&mut self.chunk_onsets, &mut self.wall_slots);
             if parallel {
-                self.pairs
-                    .par_chunks_mut(PAIR_CHUNK)
-                    .zip(self.pair_out.par_chunks_mut(PAIR_CHUNK))
-                    .zip(self.pair_const.par_chunks(PAIR_CHUNK))
-                    .map(kernel)
-                    .collect_into_vec(&mut self.chunk_onsets);
+                rayon::join(
+                    || {
+                        pairs
+                            .par_chunks_mut(PAIR_CHUNK)
+                            .zip(pair_out.par_chunks_mut(PAIR_CHUNK))
+                            .zip(pair_const.par_chunks(PAIR_CHUNK))
+                            .map(kernel)
+                            .collect_into_vec(onsets)
+                    },
+                    || {
+                        slots
+                            .par_chunks_mut(PARTICLE_CHUNK * stride)
+                            .enumerate()
+                            .for_each(|(c, s)| wall_chunk::<E>(&wall_ctx, c * PARTICLE_CHUNK, s))
+                    },
+                );
             } else {
-                self.chunk_onsets.clear();
-                let onsets = &mut self.chunk_onsets;
-                for chunk in self
-                    .pairs
+                onsets.clear();
+                for chunk in pairs
                     .chunks_mut(PAIR_CHUNK)
-                    .zip(self.pair_out.chunks_mut(PAIR_CHUNK))
-                    .zip(self.pair_const.chunks(PAIR_CHUNK))
+                    .zip(pair_out.chunks_mut(PAIR_CHUNK))
+                    .zip(pair_const.chunks(PAIR_CHUNK))
                 {
                     onsets.push(kernel(chunk));
                 }
+                wall_chunk::<E>(&wall_ctx, 0, slots);
             }
         }
-        // ---- particle phase
-        let stride = self.wall_stride;
+        // ---- particle phase: gather in list order, advance
         {
             let ctx = ParticleCtx {
                 pairs: &self.pairs,
@@ -1199,17 +1268,11 @@ impl Simulation {
                 csr_entry: &self.csr_entry,
                 radius: &self.radius,
                 inv_mass: &self.inv_mass,
-                inertia: &self.inertia,
                 inv_inertia: &self.inv_inertia,
                 alive: &self.alive,
                 reference_position: &self.reference_position,
-                walls: &self.walls,
-                wall_state: &self.wall_state,
-                laws: &self.laws,
-                model: self.model,
                 effects: self.effects,
                 gravity: self.gravity,
-                clamp: self.clamp,
                 dt: self.dt,
                 wall_stride: stride,
             };
@@ -1221,7 +1284,7 @@ impl Simulation {
                     .zip(self.contact_force_sum.par_chunks_mut(PARTICLE_CHUNK))
                     .zip(self.coordination.par_chunks_mut(PARTICLE_CHUNK))
                     .zip(self.wall_coordination.par_chunks_mut(PARTICLE_CHUNK))
-                    .zip(self.wall_slots.par_chunks_mut(PARTICLE_CHUNK * stride))
+                    .zip(self.wall_slots.par_chunks(PARTICLE_CHUNK * stride))
                     .enumerate()
                     .map(|(c, ((((((x, v), w), f), z), zw), s))| {
                         particle_chunk::<E>(&ctx, c * PARTICLE_CHUNK, x, v, w, f, z, zw, s)
@@ -1237,7 +1300,7 @@ impl Simulation {
                     .zip(self.contact_force_sum.chunks_mut(PARTICLE_CHUNK))
                     .zip(self.coordination.chunks_mut(PARTICLE_CHUNK))
                     .zip(self.wall_coordination.chunks_mut(PARTICLE_CHUNK))
-                    .zip(self.wall_slots.chunks_mut(PARTICLE_CHUNK * stride))
+                    .zip(self.wall_slots.chunks(PARTICLE_CHUNK * stride))
                     .enumerate();
                 for (c, ((((((x, v), w), f), z), zw), s)) in iter {
                     self.chunk_results.push(particle_chunk::<E>(
