@@ -1186,6 +1186,11 @@ impl Simulation {
     /// Pair phase and particle phase of one step, specialised on the effect set `E`.
     fn force_and_advance<const E: u16>(&mut self, parallel: bool) {
         let stride = self.wall_stride;
+        // rayon may split each parallel loop into at most about two tasks per thread: the step
+        // lasts microseconds, so fewer, larger tasks beat finer load balancing
+        let tasks = 2 * self.threads.max(1);
+        let pair_min = self.pairs.len().div_ceil(PAIR_CHUNK).div_ceil(tasks).max(1);
+        let particle_min = self.position.len().div_ceil(PARTICLE_CHUNK).div_ceil(tasks).max(1);
         // ---- force phase: every pair and every wall slot writes its own record only
         {
             let pair_ctx = PairCtx {
@@ -1237,6 +1242,7 @@ impl Simulation {
                             .par_chunks_mut(PAIR_CHUNK)
                             .zip(pair_out.par_chunks_mut(PAIR_CHUNK))
                             .zip(pair_const.par_chunks(PAIR_CHUNK))
+                            .with_min_len(pair_min)
                             .map(kernel)
                             .collect_into_vec(onsets)
                     },
@@ -1244,6 +1250,7 @@ impl Simulation {
                         slots
                             .par_chunks_mut(PARTICLE_CHUNK * stride)
                             .enumerate()
+                            .with_min_len(particle_min)
                             .for_each(|(c, s)| wall_chunk::<E>(&wall_ctx, c * PARTICLE_CHUNK, s))
                     },
                 );
@@ -1286,6 +1293,7 @@ impl Simulation {
                     .zip(self.wall_coordination.par_chunks_mut(PARTICLE_CHUNK))
                     .zip(self.wall_slots.par_chunks(PARTICLE_CHUNK * stride))
                     .enumerate()
+                    .with_min_len(particle_min)
                     .map(|(c, ((((((x, v), w), f), z), zw), s))| {
                         particle_chunk::<E>(&ctx, c * PARTICLE_CHUNK, x, v, w, f, z, zw, s)
                     })
