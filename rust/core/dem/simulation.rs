@@ -557,19 +557,21 @@ fn pair_kernel<const E: u16>(
 /// Closest point, unit normal (wall → x) and distance of a wall slot when the sphere of
 /// radius r touches it. Half-spaces (the belt) by hand: one dot product, nothing else when
 /// out of reach.
+/// `offset` is `None` for walls that do not move (no `moving_walls` effect).
 #[inline(always)]
-fn wall_hit(wall: &Wall, x: Vec3, offset: Vec3, r: f64) -> Option<(Vec3, Vec3, f64)> {
+fn wall_hit(wall: &Wall, x: Vec3, offset: Option<Vec3>, r: f64) -> Option<(Vec3, Vec3, f64)> {
     match &wall.shape {
         WallShape::Plane { point, normal } => {
-            let p = x - offset;
+            let p = offset.map_or(x, |o| x - o);
             let d = normal.dot(p - *point);
             if d < r {
-                Some(((p - d * *normal) + offset, *normal, d))
+                let q = p - d * *normal;
+                Some((offset.map_or(q, |o| q + o), *normal, d))
             } else {
                 None
             }
         }
-        _ => match wall.closest_at(x, offset) {
+        _ => match wall.closest_at(x, offset.unwrap_or(Vec3::ZERO)) {
             Some(h) if h.2 < r => Some(h),
             _ => None,
         },
@@ -588,9 +590,15 @@ fn wall_kernel<const E: u16>(
     c: &WallCtx<'_>,
 ) {
     let wall = &c.walls[s.wall as usize];
-    let ws = c.wall_state[s.wall as usize];
+    // fixed walls (no moving_walls effect) sit at offset 0 with velocity 0: skip both
+    let moving = on::<E>(c.effects, Effect::MovingWalls);
+    let ws = if moving {
+        c.wall_state[s.wall as usize]
+    } else {
+        WallState::default()
+    };
     let r = c.radius[i];
-    let (point, out_normal, dist) = match wall_hit(wall, x, ws.offset, r) {
+    let (point, out_normal, dist) = match wall_hit(wall, x, moving.then_some(ws.offset), r) {
         Some(h) => h,
         None => {
             if s.active {
@@ -612,7 +620,8 @@ fn wall_kernel<const E: u16>(
     let mut wall_v = ws.velocity;
     if on::<E>(c.effects, Effect::Belt) {
         let s_v = wall.surface_velocity;
-        wall_v += s_v - s_v.dot(n) * n;
+        let belt = s_v - s_v.dot(n) * n;
+        wall_v = if moving { wall_v + belt } else { belt };
     }
     let mut v_rel = v - wall_v;
     if rotation {
