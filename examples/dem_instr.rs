@@ -4,9 +4,13 @@
 //! `steps` steps on `threads` threads. Instructions per particle-step are the difference of two
 //! runs with different `steps`, divided by 840 × the step difference.
 //!
-//! Usage: `dem_instr <checkpoint path> <steps> [threads]`.
+//! An optional fourth argument runs an effect variant of the bench (`without_damping`,
+//! `without_belt`, `plus_planar`, `plus_rolling_resistance`) from the settled state instead.
+//!
+//! Usage: `dem_instr <checkpoint path> <steps> [threads] [variant]`.
 use demfem::dem::table::{anchor_scene, TableStart};
-use demfem::dem::Simulation;
+use demfem::dem::{Effect, Simulation};
+use demfem::geometry::Vec3;
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -24,6 +28,34 @@ fn main() {
     } else {
         sim.step(60_000).unwrap();
         sim.save_checkpoint(&path).unwrap();
+    }
+    if let Some(variant) = args.get(4) {
+        scene.particles.position = sim.positions().to_vec();
+        scene.particles.velocity = sim.velocities().to_vec();
+        scene.particles.angular_velocity = sim.angular_velocities().to_vec();
+        match variant.as_str() {
+            "without_damping" => {
+                scene.effects = scene.effects.without(Effect::Damping);
+                scene.materials[0].restitution = 1.0;
+            }
+            "without_belt" => {
+                scene.effects = scene.effects.without(Effect::Belt);
+                scene.walls[0].surface_velocity = Vec3::ZERO;
+            }
+            "plus_planar" => {
+                scene.effects = scene.effects.with(Effect::Planar);
+                for w in scene.particles.angular_velocity.iter_mut() {
+                    w.x = 0.0;
+                    w.y = 0.0;
+                }
+            }
+            "plus_rolling_resistance" => {
+                scene.effects = scene.effects.with(Effect::RollingResistance);
+                scene.materials[0].rolling_friction = 0.01;
+            }
+            other => panic!("unknown variant {other}"),
+        }
+        sim = Simulation::new(&scene).unwrap();
     }
     sim.step(steps).unwrap();
     let z: u32 = sim.coordination().iter().sum();
