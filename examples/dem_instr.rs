@@ -59,8 +59,21 @@ fn main() {
     }
     sim.step(steps).unwrap();
     let z: u32 = sim.coordination().iter().sum();
+    // FNV-1a over the bits of every position, velocity and angular velocity: equal hashes
+    // mean bitwise equal states
+    let mut hash = 0xcbf29ce484222325u64;
+    for v in sim
+        .positions()
+        .iter()
+        .chain(sim.velocities())
+        .chain(sim.angular_velocities())
+    {
+        for x in [v.x, v.y, v.z] {
+            hash = (hash ^ x.to_bits()).wrapping_mul(0x100000001b3);
+        }
+    }
     println!(
-        "steps {} rebuilds {} Z {:.3} max overlap {:.3e} x0 {:?}",
+        "state hash {hash:016x} steps {} rebuilds {} Z {:.3} max overlap {:.3e} x0 {:?}",
         sim.steps(),
         sim.rebuilds(),
         z as f64 / sim.len() as f64,
