@@ -226,8 +226,13 @@ pub struct Simulation {
     pub(crate) reference_wall_offset: Vec<Vec3>,
     pub(crate) needs_rebuild: bool,
     // ---- derived, rebuilt from the state
+    /// Gather lists: `csr_entry[csr_offset[i]..csr_offset[i + 1]]` are the indices, in
+    /// increasing order, of the pairs in which particle i is the second particle (j).
     pub(crate) csr_offset: Vec<u32>,
     pub(crate) csr_entry: Vec<u32>,
+    /// The pairs in which particle i is the first particle are
+    /// `pairs[pair_start[i]..pair_start[i + 1]]` (the list is sorted by (i, j)).
+    pub(crate) pair_start: Vec<u32>,
     grid: CellGrid,
     candidate_scratch: Vec<(u32, u32)>,
     old_pairs: Vec<PairContact>,
@@ -298,6 +303,7 @@ struct ParticleCtx<'a> {
     pair_out: &'a [PairOut],
     csr_offset: &'a [u32],
     csr_entry: &'a [u32],
+    pair_start: &'a [u32],
     radius: &'a [f64],
     inv_mass: &'a [f64],
     inv_inertia: &'a [f64],
@@ -731,6 +737,7 @@ fn particle_chunk<const E: u16>(
     let inv_inertia = &c.inv_inertia[first..last];
     let reference = &c.reference_position[first..last];
     let offset = &c.csr_offset[first..=last];
+    let pair_start = &c.pair_start[first..=last];
     let (velocity, omega) = (&mut velocity[..len], &mut omega[..len]);
     let (force_sum, coordination) = (&mut force_sum[..len], &mut coordination[..len]);
     let wall_coordination = &mut wall_coordination[..len];
@@ -742,23 +749,36 @@ fn particle_chunk<const E: u16>(
         let mut f = Vec3::ZERO;
         let mut t = Vec3::ZERO;
         let mut z = 0u32;
+        // pairs in increasing index order: first those where the particle is j (their i is
+        // smaller, so their indices come first), listed in the CSR ...
         for &e in &c.csr_entry[offset[k] as usize..offset[k + 1] as usize] {
-            let p = &c.pair_out[(e >> 1) as usize];
+            let p = &c.pair_out[e as usize];
             if !(p.overlap > 0.0) {
                 continue;
             }
             z += 1;
-            if e & 1 == 0 {
-                f += p.force;
-            } else {
-                f -= p.force;
-            }
+            f -= p.force;
             if rotation {
                 let arm = radius[k] - 0.5 * p.overlap;
                 t += arm * p.torque_per_arm;
                 if rolling {
-                    let m = c.pairs[(e >> 1) as usize].rolling_torque;
-                    t += if e & 1 == 0 { m } else { -m };
+                    t -= c.pairs[e as usize].rolling_torque;
+                }
+            }
+        }
+        // ... then those where it is i: a contiguous range of the sorted pair list
+        for e in pair_start[k] as usize..pair_start[k + 1] as usize {
+            let p = &c.pair_out[e];
+            if !(p.overlap > 0.0) {
+                continue;
+            }
+            z += 1;
+            f += p.force;
+            if rotation {
+                let arm = radius[k] - 0.5 * p.overlap;
+                t += arm * p.torque_per_arm;
+                if rolling {
+                    t += c.pairs[e].rolling_torque;
                 }
             }
         }
@@ -920,6 +940,7 @@ impl Simulation {
             needs_rebuild: true,
             csr_offset: vec![0; n + 1],
             csr_entry: Vec::new(),
+            pair_start: vec![0; n + 1],
             grid: CellGrid::default(),
             candidate_scratch: Vec::new(),
             old_pairs: Vec::new(),
@@ -990,29 +1011,31 @@ impl Simulation {
         }
     }
 
-    /// Gather lists (CSR): the pair indices of each particle in increasing order, tagged
-    /// with the side (bit 0: particle is j). A pure function of the pair list.
+    /// Gather lists: for each particle, the pairs where it is j (CSR, increasing pair index)
+    /// and the range of pairs where it is i (`pair_start`; the pair list is sorted by (i, j)).
+    /// Visiting the first, then the second, visits a particle's pairs in increasing index
+    /// order. A pure function of the pair list.
     pub(crate) fn build_gather_lists(&mut self) {
         let n = self.position.len();
         self.pair_out.clear();
         self.pair_out.resize(self.pairs.len(), PairOut::default());
         self.csr_offset.clear();
         self.csr_offset.resize(n + 1, 0);
+        self.pair_start.clear();
+        self.pair_start.resize(n + 1, 0);
         for p in &self.pairs {
-            self.csr_offset[p.i as usize + 1] += 1;
+            self.pair_start[p.i as usize + 1] += 1;
             self.csr_offset[p.j as usize + 1] += 1;
         }
         for i in 0..n {
+            self.pair_start[i + 1] += self.pair_start[i];
             self.csr_offset[i + 1] += self.csr_offset[i];
         }
         self.csr_entry.clear();
         self.csr_entry.resize(self.csr_offset[n] as usize, 0);
         let mut fill: Vec<u32> = self.csr_offset[..n].to_vec();
         for (k, p) in self.pairs.iter().enumerate() {
-            let e = (k as u32) << 1;
-            self.csr_entry[fill[p.i as usize] as usize] = e;
-            fill[p.i as usize] += 1;
-            self.csr_entry[fill[p.j as usize] as usize] = e | 1;
+            self.csr_entry[fill[p.j as usize] as usize] = k as u32;
             fill[p.j as usize] += 1;
         }
     }
@@ -1282,6 +1305,7 @@ impl Simulation {
                 pair_out: &self.pair_out,
                 csr_offset: &self.csr_offset,
                 csr_entry: &self.csr_entry,
+                pair_start: &self.pair_start,
                 radius: &self.radius,
                 inv_mass: &self.inv_mass,
                 inv_inertia: &self.inv_inertia,
