@@ -296,6 +296,7 @@ impl Simulation {
         self.wall_stride = stride;
         self.wall_slots = slots;
         self.build_gather_lists();
+        self.refresh_contact_constants();
         self.refresh_wall_state();
         Ok(())
     }

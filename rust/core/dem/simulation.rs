@@ -3,11 +3,19 @@
 //!
 //! One step (leapfrog, velocities stored at half steps):
 //! 1. rebuild the Verlet lists if a particle or a wall moved more than half the skin;
-//! 2. **pair phase** — for every candidate pair, in parallel chunks, the contact force from
-//!    x(t) and v(t − Δt/2) is written into the pair's own slot (no shared accumulator);
+//! 2. **force phase** — for every candidate pair and every particle–wall slot, in parallel
+//!    chunks (pairs and walls side by side in one `rayon::join`), the contact force from x(t)
+//!    and v(t − Δt/2) is written into the pair's or slot's own record (no shared accumulator);
 //! 3. **particle phase** — for every particle, in parallel chunks: the pair forces are gathered
-//!    in the fixed order of the particle's pair list, the particle's own wall contacts are
-//!    computed, and the particle is advanced: v += F/m Δt, x += v Δt, ω += T/I Δt.
+//!    in the fixed order of the particle's pair list, then its wall slots' forces in slot
+//!    order, and the particle is advanced: v += F/m Δt, x += v Δt, ω += T/I Δt.
+//!
+//! The kernels are monomorphised over the effect set (const generic `E`): the anchor table's
+//! set (with and without `planar`) gets a specialised step without effect tests in the inner
+//! loops, any other set runs the generic one. Law constants that depend only on the two bodies
+//! (E*, G*, √R*, m*, damping prefactor, friction) are derived once per neighbour-list rebuild
+//! (`ContactConst`), so a contact costs three square roots (distance, √δ, δ^{1/4}) and one
+//! division, plus a square root and two divisions in gross sliding.
 //!
 //! Every floating-point sum is taken in an order fixed by the lists, never by the thread
 //! schedule, so results are bitwise identical for any thread count; the step synchronises
@@ -22,7 +30,7 @@ use crate::dem::neighbor::CellGrid;
 use crate::dem::record::{ContactOnset, ContactRecord, Frame, Partner};
 use crate::dem::scene::Scene;
 use crate::error::{DemfemError, Result};
-use crate::geometry::{Vec3, Wall};
+use crate::geometry::{Vec3, Wall, WallShape};
 
 /// Below this many particles the step runs on the calling thread whatever `threads` says:
 /// a rayon fork-join costs microseconds, as much as the whole step of a small system.
@@ -31,33 +39,81 @@ const PAIR_CHUNK: usize = 256;
 const PARTICLE_CHUNK: usize = 64;
 const NO_WALL: u32 = u32::MAX;
 
-/// A candidate particle pair of the Verlet list with its contact state. `repr(C)` with the
-/// fields the gather reads (force, torque, overlap) in the first 64-byte cache line: the
-/// gather visits pairs in particle order, not memory order.
+/// A candidate particle pair of the Verlet list with its contact state. `repr(C)` with what
+/// the pair phase reads for every candidate (i, j, the activity flags and r_i + r_j) at the
+/// front, so a pair that is not in contact costs one cache line and no store.
 #[derive(Debug, Clone, Copy, Default)]
 #[repr(C)]
 pub(crate) struct PairContact {
-    /// Force on particle i, N.
-    pub(crate) force: Vec3,
-    /// n × F_t: the torque on i (and on j) per unit lever arm, N.
-    pub(crate) torque_per_arm: Vec3,
-    /// Overlap δ, m; > 0 exactly when the pair is in contact (the gather's activity test).
-    pub(crate) overlap: f64,
     pub(crate) i: u32,
     pub(crate) j: u32,
-    /// Rolling-resistance torque on i (−this on j), N·m.
-    pub(crate) rolling_torque: Vec3,
-    /// Tangential spring displacement ξ, m (Mindlin history).
-    pub(crate) history: Vec3,
-    /// Unit normal from i to j.
-    pub(crate) normal: Vec3,
-    pub(crate) normal_force: f64,
-    pub(crate) onset_normal_speed: f64,
-    pub(crate) onset_tangential_speed: f64,
     /// In contact at the last force evaluation.
     pub(crate) active: bool,
     /// The contact began at the last force evaluation.
     pub(crate) onset: bool,
+    /// r_i + r_j, m (derived from the radii at rebuild and restore; not checkpointed).
+    pub(crate) r_sum: f64,
+    /// Tangential spring displacement ξ, m (Mindlin history).
+    pub(crate) history: Vec3,
+    /// Force on particle i, N.
+    pub(crate) force: Vec3,
+    /// Unit normal from i to j.
+    pub(crate) normal: Vec3,
+    /// Overlap δ, m; > 0 exactly when the pair is in contact.
+    pub(crate) overlap: f64,
+    pub(crate) normal_force: f64,
+    /// Rolling-resistance torque on i (−this on j), N·m.
+    pub(crate) rolling_torque: Vec3,
+    pub(crate) onset_normal_speed: f64,
+    pub(crate) onset_tangential_speed: f64,
+}
+
+/// Constants of one contact (a pair or a particle–wall slot) derived from the pair law, the
+/// reduced radius and the reduced mass once per neighbour-list rebuild, so the kernels do no
+/// division and no law-table lookup per step. For the Hertz laws (`hertz`), with s = √δ:
+/// F_el = `f_el` s δ, k_t = `k_t` s, c_n = `c_n` √s, which equal 4/3 E* a δ, 8 G* a and
+/// ζ √(2/3 m* 2E* a) for a = √(R* δ).
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct ContactConst {
+    r_star: f64,
+    m_star: f64,
+    /// 4/3 E* √R*.
+    f_el: f64,
+    /// 8 G* √R*.
+    k_t: f64,
+    /// ζ √(4/3 m* E* √R*).
+    c_n: f64,
+    /// c_t / c_n.
+    ct_ratio: f64,
+    /// Coulomb friction μ.
+    mu: f64,
+    /// Index of the pair law.
+    law: u32,
+    /// The closed forms above apply (Hertz–Mindlin, or Hertz–Reissner without shell).
+    hertz: bool,
+}
+
+impl ContactConst {
+    fn new(model: ContactModel, laws: &[PairLaw], law: usize, r_star: f64, m_star: f64) -> Self {
+        let l = &laws[law];
+        let hertz = match model {
+            ContactModel::HertzMindlin => true,
+            ContactModel::HertzReissnerMindlin => l.shell_stiffness.is_infinite(),
+            ContactModel::LinearSpringDashpot { .. } => false,
+        };
+        let sr = r_star.sqrt();
+        ContactConst {
+            r_star,
+            m_star,
+            f_el: 4.0 / 3.0 * l.e_star * sr,
+            k_t: 8.0 * l.g_star * sr,
+            c_n: l.zeta * (2.0 / 3.0 * m_star * (2.0 * l.e_star * sr)).sqrt(),
+            ct_ratio: l.tangential_damping_ratio,
+            mu: l.friction,
+            law: law as u32,
+            hertz,
+        }
+    }
 }
 
 /// What the gather needs of a pair, written by the pair phase every step: one 64-byte line
@@ -76,10 +132,14 @@ pub(crate) struct PairOut {
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct WallContact {
     pub(crate) wall: u32,
+    /// Law constants of this particle against this wall (derived, not checkpointed).
+    pub(crate) k: ContactConst,
     pub(crate) active: bool,
     pub(crate) onset: bool,
     pub(crate) history: Vec3,
     pub(crate) force: Vec3,
+    /// Torque on the particle, N·m (zero when not in contact).
+    pub(crate) torque: Vec3,
     pub(crate) normal: Vec3,
     pub(crate) point: Vec3,
     pub(crate) overlap: f64,
@@ -92,10 +152,12 @@ impl Default for WallContact {
     fn default() -> Self {
         WallContact {
             wall: NO_WALL,
+            k: ContactConst::default(),
             active: false,
             onset: false,
             history: Vec3::ZERO,
             force: Vec3::ZERO,
+            torque: Vec3::ZERO,
             normal: Vec3::ZERO,
             point: Vec3::ZERO,
             overlap: 0.0,
@@ -156,14 +218,21 @@ pub struct Simulation {
     pub(crate) steps: u64,
     pub(crate) pairs: Vec<PairContact>,
     pair_out: Vec<PairOut>,
+    /// Law constants of each pair (derived at rebuild and restore).
+    pair_const: Vec<ContactConst>,
     pub(crate) wall_slots: Vec<WallContact>,
     pub(crate) wall_stride: usize,
     pub(crate) reference_position: Vec<Vec3>,
     pub(crate) reference_wall_offset: Vec<Vec3>,
     pub(crate) needs_rebuild: bool,
     // ---- derived, rebuilt from the state
+    /// Gather lists: `csr_entry[csr_offset[i]..csr_offset[i + 1]]` are the indices, in
+    /// increasing order, of the pairs in which particle i is the second particle (j).
     pub(crate) csr_offset: Vec<u32>,
     pub(crate) csr_entry: Vec<u32>,
+    /// The pairs in which particle i is the first particle are
+    /// `pairs[pair_start[i]..pair_start[i + 1]]` (the list is sorted by (i, j)).
+    pub(crate) pair_start: Vec<u32>,
     grid: CellGrid,
     candidate_scratch: Vec<(u32, u32)>,
     old_pairs: Vec<PairContact>,
@@ -202,15 +271,30 @@ struct PairCtx<'a> {
     velocity: &'a [Vec3],
     omega: &'a [Vec3],
     radius: &'a [f64],
-    mass: &'a [f64],
     inertia: &'a [f64],
-    material: &'a [u32],
     laws: &'a [PairLaw],
-    n_materials: usize,
     model: ContactModel,
     effects: EffectSet,
     clamp: bool,
     dt: f64,
+}
+
+/// Read-only context of the wall kernels (run in the force phase, next to the pairs).
+struct WallCtx<'a> {
+    position: &'a [Vec3],
+    velocity: &'a [Vec3],
+    omega: &'a [Vec3],
+    alive: &'a [bool],
+    radius: &'a [f64],
+    inertia: &'a [f64],
+    walls: &'a [Wall],
+    wall_state: &'a [WallState],
+    laws: &'a [PairLaw],
+    model: ContactModel,
+    effects: EffectSet,
+    clamp: bool,
+    dt: f64,
+    wall_stride: usize,
 }
 
 /// Read-only context of the particle phase.
@@ -219,22 +303,14 @@ struct ParticleCtx<'a> {
     pair_out: &'a [PairOut],
     csr_offset: &'a [u32],
     csr_entry: &'a [u32],
+    pair_start: &'a [u32],
     radius: &'a [f64],
-    mass: &'a [f64],
     inv_mass: &'a [f64],
-    inertia: &'a [f64],
     inv_inertia: &'a [f64],
-    material: &'a [u32],
     alive: &'a [bool],
     reference_position: &'a [Vec3],
-    walls: &'a [Wall],
-    wall_state: &'a [WallState],
-    laws: &'a [PairLaw],
-    n_materials: usize,
-    model: ContactModel,
     effects: EffectSet,
     gravity: Vec3,
-    clamp: bool,
     dt: f64,
     wall_stride: usize,
 }
@@ -332,26 +408,87 @@ fn tangential_force(
     f_t
 }
 
+/// `E` value of the kernels' const generic that reads the effect set at run time; any other
+/// value is the effect bit set itself, so `on::<E>` folds to a constant and the specialised
+/// kernels carry no effect tests (see [`Simulation::step`] for the specialised sets).
+const DYNAMIC: u16 = u16::MAX;
+
+/// The anchor table's effects (gravity, belt, friction, rotation, damping): a specialised step.
+const TABLE: u16 = Effect::Gravity as u16
+    | Effect::Belt as u16
+    | Effect::Friction as u16
+    | Effect::Rotation as u16
+    | Effect::Damping as u16;
+/// The upright-cartridge table: [`TABLE`] plus planar motion.
+const TABLE_PLANAR: u16 = TABLE | Effect::Planar as u16;
+
+/// Whether effect `e` is on: a compile-time constant unless `E` is [`DYNAMIC`].
+#[inline(always)]
+fn on<const E: u16>(runtime: EffectSet, e: Effect) -> bool {
+    if E == DYNAMIC {
+        runtime.has(e)
+    } else {
+        E & e as u16 != 0
+    }
+}
+
+/// Elastic normal force, damping coefficient and tangential stiffness of a contact at
+/// overlap δ from its precomputed constants.
+#[inline(always)]
+fn law_at<const E: u16>(
+    k: &ContactConst,
+    model: ContactModel,
+    laws: &[PairLaw],
+    effects: EffectSet,
+    overlap: f64,
+) -> (f64, f64, f64) {
+    if k.hertz {
+        let s = overlap.sqrt();
+        let c_n = if on::<E>(effects, Effect::Damping) {
+            k.c_n * s.sqrt()
+        } else {
+            0.0
+        };
+        (k.f_el * s * overlap, c_n, k.k_t * s)
+    } else {
+        let (f_el, c_n, k_t, _) = contact_law(
+            model,
+            &laws[k.law as usize],
+            effects,
+            overlap,
+            k.r_star,
+            k.m_star,
+        );
+        (f_el, c_n, k_t)
+    }
+}
+
 /// Force of one candidate pair; returns whether a contact began.
 #[inline(always)]
-fn pair_kernel(p: &mut PairContact, out: &mut PairOut, c: &PairCtx<'_>) -> bool {
+fn pair_kernel<const E: u16>(
+    p: &mut PairContact,
+    k: &ContactConst,
+    out: &mut PairOut,
+    c: &PairCtx<'_>,
+) -> bool {
     let i = p.i as usize;
     let j = p.j as usize;
     let d = c.position[j] - c.position[i];
     let dist2 = d.length_squared();
-    let r_sum = c.radius[i] + c.radius[j];
+    let r_sum = p.r_sum;
     if dist2 >= r_sum * r_sum || dist2 == 0.0 {
+        // an inactive pair has nothing to reset: its output slot already reads "no contact"
+        // (onset is only ever set together with active)
         if p.active {
             p.active = false;
+            p.onset = false;
             p.history = Vec3::ZERO;
             p.force = Vec3::ZERO;
-            p.torque_per_arm = Vec3::ZERO;
             p.rolling_torque = Vec3::ZERO;
             p.overlap = 0.0;
             p.normal_force = 0.0;
+            out.overlap = 0.0;
         }
-        out.overlap = 0.0;
-        p.onset = false;
         return false;
     }
     let dist = dist2.sqrt();
@@ -359,11 +496,11 @@ fn pair_kernel(p: &mut PairContact, out: &mut PairOut, c: &PairCtx<'_>) -> bool 
     // the gather's activity test
     let overlap = (r_sum - dist).max(f64::MIN_POSITIVE);
     let n = d * (1.0 / dist); // one division instead of three
-    let rotation = c.effects.has(Effect::Rotation);
-    let arm_i = c.radius[i] - 0.5 * overlap;
-    let arm_j = c.radius[j] - 0.5 * overlap;
+    let rotation = on::<E>(c.effects, Effect::Rotation);
     let mut v_rel = c.velocity[i] - c.velocity[j];
     if rotation {
+        let arm_i = c.radius[i] - 0.5 * overlap;
+        let arm_j = c.radius[j] - 0.5 * overlap;
         v_rel += (arm_i * c.omega[i] + arm_j * c.omega[j]).cross(n);
     }
     let v_n = v_rel.dot(n); // > 0 approaching
@@ -375,36 +512,37 @@ fn pair_kernel(p: &mut PairContact, out: &mut PairOut, c: &PairCtx<'_>) -> bool 
         p.onset_normal_speed = v_n;
         p.onset_tangential_speed = v_t.length();
     }
-    let law = &c.laws[c.material[i] as usize * c.n_materials + c.material[j] as usize];
-    let m_star = c.mass[i] * c.mass[j] / (c.mass[i] + c.mass[j]);
-    let r_star = c.radius[i] * c.radius[j] / r_sum;
-    let (f_el, c_n, k_t, _) = contact_law(c.model, law, c.effects, overlap, r_star, m_star);
+    let (f_el, c_n, k_t) = law_at::<E>(k, c.model, c.laws, c.effects, overlap);
     let mut f_n = f_el + c_n * v_n;
     if c.clamp && f_n < 0.0 {
         f_n = 0.0;
     }
     let mut force = -f_n * n;
-    if c.effects.has(Effect::Friction) {
+    let mut torque_per_arm = Vec3::ZERO;
+    if on::<E>(c.effects, Effect::Friction) {
         let f_t = tangential_force(
             &mut p.history,
             n,
             v_t,
             k_t,
-            c_n * law.tangential_damping_ratio,
-            law.friction * f_n.max(0.0),
+            c_n * k.ct_ratio,
+            k.mu * f_n.max(0.0),
             c.dt,
         );
         force += f_t;
-        p.torque_per_arm = if rotation { n.cross(f_t) } else { Vec3::ZERO };
+        if rotation {
+            torque_per_arm = n.cross(f_t);
+        }
     }
-    if c.effects.has(Effect::RollingResistance) {
+    if on::<E>(c.effects, Effect::RollingResistance) {
+        let law = &c.laws[k.law as usize];
         let w_rel = c.omega[i] - c.omega[j];
         let w_roll = w_rel - w_rel.dot(n) * n;
         let w_mag = w_roll.length();
         if w_mag > 0.0 {
             let i_star = c.inertia[i] * c.inertia[j] / (c.inertia[i] + c.inertia[j]);
             // constant torque, but never more than what stops the relative rolling in one step
-            let m = (law.rolling_friction * r_star * f_n.max(0.0)).min(i_star * w_mag / c.dt);
+            let m = (law.rolling_friction * k.r_star * f_n.max(0.0)).min(i_star * w_mag / c.dt);
             p.rolling_torque = -m / w_mag * w_roll;
         } else {
             p.rolling_torque = Vec3::ZERO;
@@ -416,48 +554,80 @@ fn pair_kernel(p: &mut PairContact, out: &mut PairOut, c: &PairCtx<'_>) -> bool 
     p.normal_force = f_n;
     *out = PairOut {
         force,
-        torque_per_arm: p.torque_per_arm,
+        torque_per_arm,
         overlap,
     };
     onset
 }
 
-/// Force of one particle–wall slot on particle i; returns (force, torque) and flags onset.
+/// Closest point, unit normal (wall → x) and distance of a wall slot when the sphere of
+/// radius r touches it. Half-spaces (the belt) by hand: one dot product, nothing else when
+/// out of reach.
+/// `offset` is `None` for walls that do not move (no `moving_walls` effect).
 #[inline(always)]
-fn wall_kernel(
+fn wall_hit(wall: &Wall, x: Vec3, offset: Option<Vec3>, r: f64) -> Option<(Vec3, Vec3, f64)> {
+    match &wall.shape {
+        WallShape::Plane { point, normal } => {
+            let p = offset.map_or(x, |o| x - o);
+            let d = normal.dot(p - *point);
+            if d < r {
+                let q = p - d * *normal;
+                Some((offset.map_or(q, |o| q + o), *normal, d))
+            } else {
+                None
+            }
+        }
+        _ => match wall.closest_at(x, offset.unwrap_or(Vec3::ZERO)) {
+            Some(h) if h.2 < r => Some(h),
+            _ => None,
+        },
+    }
+}
+
+/// Force and torque of one particle–wall slot on particle i, stored in the slot with the
+/// contact state; flags onset.
+#[inline(always)]
+fn wall_kernel<const E: u16>(
     s: &mut WallContact,
     i: usize,
     x: Vec3,
     v: Vec3,
     w: Vec3,
-    c: &ParticleCtx<'_>,
-) -> (Vec3, Vec3) {
+    c: &WallCtx<'_>,
+) {
     let wall = &c.walls[s.wall as usize];
-    let ws = c.wall_state[s.wall as usize];
+    // fixed walls (no moving_walls effect) sit at offset 0 with velocity 0: skip both
+    let moving = on::<E>(c.effects, Effect::MovingWalls);
+    let ws = if moving {
+        c.wall_state[s.wall as usize]
+    } else {
+        WallState::default()
+    };
     let r = c.radius[i];
-    let hit = wall.closest_at(x, ws.offset);
-    let (point, out_normal, dist) = match hit {
-        Some(h) if h.2 < r => h,
-        _ => {
+    let (point, out_normal, dist) = match wall_hit(wall, x, moving.then_some(ws.offset), r) {
+        Some(h) => h,
+        None => {
             if s.active {
                 s.active = false;
                 s.history = Vec3::ZERO;
                 s.force = Vec3::ZERO;
+                s.torque = Vec3::ZERO;
                 s.overlap = 0.0;
                 s.normal_force = 0.0;
             }
             s.onset = false;
-            return (Vec3::ZERO, Vec3::ZERO);
+            return;
         }
     };
     let n = -out_normal; // from the particle towards the wall
     let overlap = r - dist;
-    let rotation = c.effects.has(Effect::Rotation);
+    let rotation = on::<E>(c.effects, Effect::Rotation);
     let arm = dist.max(0.0);
     let mut wall_v = ws.velocity;
-    if c.effects.has(Effect::Belt) {
+    if on::<E>(c.effects, Effect::Belt) {
         let s_v = wall.surface_velocity;
-        wall_v += s_v - s_v.dot(n) * n;
+        let belt = s_v - s_v.dot(n) * n;
+        wall_v = if moving { wall_v + belt } else { belt };
     }
     let mut v_rel = v - wall_v;
     if rotation {
@@ -472,23 +642,22 @@ fn wall_kernel(
         s.onset_normal_speed = v_n;
         s.onset_tangential_speed = v_t.length();
     }
-    let law = &c.laws[c.material[i] as usize * c.n_materials + wall.material];
-    let m_star = c.mass[i];
-    let (f_el, c_n, k_t, _) = contact_law(c.model, law, c.effects, overlap, r, m_star);
+    let (f_el, c_n, k_t) = law_at::<E>(&s.k, c.model, c.laws, c.effects, overlap);
+    let (ct_ratio, mu, law) = (s.k.ct_ratio, s.k.mu, s.k.law as usize);
     let mut f_n = f_el + c_n * v_n;
     if c.clamp && f_n < 0.0 {
         f_n = 0.0;
     }
     let mut force = -f_n * n;
     let mut torque = Vec3::ZERO;
-    if c.effects.has(Effect::Friction) {
+    if on::<E>(c.effects, Effect::Friction) {
         let f_t = tangential_force(
             &mut s.history,
             n,
             v_t,
             k_t,
-            c_n * law.tangential_damping_ratio,
-            law.friction * f_n.max(0.0),
+            c_n * ct_ratio,
+            mu * f_n.max(0.0),
             c.dt,
         );
         force += f_t;
@@ -496,7 +665,8 @@ fn wall_kernel(
             torque = arm * n.cross(f_t);
         }
     }
-    if c.effects.has(Effect::RollingResistance) {
+    if on::<E>(c.effects, Effect::RollingResistance) {
+        let law = &c.laws[law];
         let w_roll = w - w.dot(n) * n;
         let w_mag = w_roll.length();
         if w_mag > 0.0 {
@@ -505,17 +675,35 @@ fn wall_kernel(
         }
     }
     s.force = force;
+    s.torque = torque;
     s.normal = n;
     s.point = point;
     s.overlap = overlap;
     s.normal_force = f_n;
-    (force, torque)
+}
+
+/// Wall kernels of the particles of one chunk starting at `first` (their slots).
+#[inline(always)]
+fn wall_chunk<const E: u16>(c: &WallCtx<'_>, first: usize, slots: &mut [WallContact]) {
+    for (k, slots) in slots.chunks_exact_mut(c.wall_stride).enumerate() {
+        let i = first + k;
+        if !c.alive[i] {
+            continue;
+        }
+        let (x, v, w) = (c.position[i], c.velocity[i], c.omega[i]);
+        for s in slots.iter_mut() {
+            if s.wall == NO_WALL {
+                break;
+            }
+            wall_kernel::<E>(s, i, x, v, w, c);
+        }
+    }
 }
 
 /// Particle phase on one chunk of particles starting at `first`. Returns (largest squared
 /// displacement since the last rebuild, any non-finite value, wall onsets).
 #[allow(clippy::too_many_arguments)]
-fn particle_chunk(
+fn particle_chunk<const E: u16>(
     c: &ParticleCtx<'_>,
     first: usize,
     position: &mut [Vec3],
@@ -524,12 +712,12 @@ fn particle_chunk(
     force_sum: &mut [Vec3],
     coordination: &mut [u32],
     wall_coordination: &mut [u32],
-    slots: &mut [WallContact],
+    slots: &[WallContact],
 ) -> (f64, bool, u32) {
-    let rotation = c.effects.has(Effect::Rotation);
-    let rolling = c.effects.has(Effect::RollingResistance);
-    let planar = c.effects.has(Effect::Planar);
-    let gravity = if c.effects.has(Effect::Gravity) {
+    let rotation = on::<E>(c.effects, Effect::Rotation);
+    let rolling = on::<E>(c.effects, Effect::RollingResistance);
+    let planar = on::<E>(c.effects, Effect::Planar);
+    let gravity = if on::<E>(c.effects, Effect::Gravity) {
         c.gravity
     } else {
         Vec3::ZERO
@@ -539,32 +727,58 @@ fn particle_chunk(
     // nine finiteness tests, checked once per chunk
     let mut probe = Vec3::ZERO;
     let mut wall_onsets = 0u32;
-    for k in 0..position.len() {
-        let i = first + k;
-        if !c.alive[i] {
+    // every per-particle array cut to this chunk once, so the loop indexes by k < len
+    // without further bounds checks
+    let len = position.len();
+    let last = first + len;
+    let alive = &c.alive[first..last];
+    let radius = &c.radius[first..last];
+    let inv_mass = &c.inv_mass[first..last];
+    let inv_inertia = &c.inv_inertia[first..last];
+    let reference = &c.reference_position[first..last];
+    let offset = &c.csr_offset[first..=last];
+    let pair_start = &c.pair_start[first..=last];
+    let (velocity, omega) = (&mut velocity[..len], &mut omega[..len]);
+    let (force_sum, coordination) = (&mut force_sum[..len], &mut coordination[..len]);
+    let wall_coordination = &mut wall_coordination[..len];
+    let stride = c.wall_stride;
+    for (k, slots) in slots.chunks_exact(stride).take(len).enumerate() {
+        if !alive[k] {
             continue;
         }
         let mut f = Vec3::ZERO;
         let mut t = Vec3::ZERO;
         let mut z = 0u32;
-        let (a, b) = (c.csr_offset[i] as usize, c.csr_offset[i + 1] as usize);
-        for &e in &c.csr_entry[a..b] {
-            let p = &c.pair_out[(e >> 1) as usize];
+        // pairs in increasing index order: first those where the particle is j (their i is
+        // smaller, so their indices come first), listed in the CSR ...
+        for &e in &c.csr_entry[offset[k] as usize..offset[k + 1] as usize] {
+            let p = &c.pair_out[e as usize];
             if !(p.overlap > 0.0) {
                 continue;
             }
             z += 1;
-            let arm = c.radius[i] - 0.5 * p.overlap;
-            if e & 1 == 0 {
-                f += p.force;
-            } else {
-                f -= p.force;
-            }
+            f -= p.force;
             if rotation {
+                let arm = radius[k] - 0.5 * p.overlap;
                 t += arm * p.torque_per_arm;
                 if rolling {
-                    let m = c.pairs[(e >> 1) as usize].rolling_torque;
-                    t += if e & 1 == 0 { m } else { -m };
+                    t -= c.pairs[e as usize].rolling_torque;
+                }
+            }
+        }
+        // ... then those where it is i: a contiguous range of the sorted pair list
+        for e in pair_start[k] as usize..pair_start[k + 1] as usize {
+            let p = &c.pair_out[e];
+            if !(p.overlap > 0.0) {
+                continue;
+            }
+            z += 1;
+            f += p.force;
+            if rotation {
+                let arm = radius[k] - 0.5 * p.overlap;
+                t += arm * p.torque_per_arm;
+                if rolling {
+                    t += c.pairs[e].rolling_torque;
                 }
             }
         }
@@ -572,32 +786,30 @@ fn particle_chunk(
             // upright cartridges cannot climb on each other: particle forces act in the plane
             f.z = 0.0;
         }
-        let (x, v, w) = (position[k], velocity[k], omega[k]);
         let mut zw = 0u32;
-        let stride = c.wall_stride;
-        for s in &mut slots[k * stride..(k + 1) * stride] {
+        for s in slots.iter() {
             if s.wall == NO_WALL {
                 break;
             }
-            let (fw, tw) = wall_kernel(s, i, x, v, w, c);
             if s.active {
                 zw += 1;
                 if s.onset {
                     wall_onsets += 1;
                 }
-                f += fw;
-                t += tw;
+                f += s.force;
+                t += s.torque;
             }
         }
+        let (x, v, w) = (position[k], velocity[k], omega[k]);
         force_sum[k] = f;
         coordination[k] = z;
         wall_coordination[k] = zw;
-        let v_new = v + (f * c.inv_mass[i] + gravity) * c.dt;
+        let v_new = v + (f * inv_mass[k] + gravity) * c.dt;
         let x_new = x + v_new * c.dt;
         velocity[k] = v_new;
         position[k] = x_new;
         if rotation {
-            let mut w_new = w + t * (c.inv_inertia[i] * c.dt);
+            let mut w_new = w + t * (inv_inertia[k] * c.dt);
             if planar {
                 w_new.x = 0.0;
                 w_new.y = 0.0;
@@ -606,7 +818,11 @@ fn particle_chunk(
             probe += w_new * 0.0;
         }
         probe += (x_new + v_new) * 0.0;
-        max_disp2 = max_disp2.max((x_new - c.reference_position[i]).length_squared());
+        // a NaN displacement is caught by the probe; no NaN-aware max needed
+        let disp2 = (x_new - reference[k]).length_squared();
+        if disp2 > max_disp2 {
+            max_disp2 = disp2;
+        }
     }
     (max_disp2, !probe.is_finite(), wall_onsets)
 }
@@ -716,6 +932,7 @@ impl Simulation {
             steps: 0,
             pairs: Vec::new(),
             pair_out: Vec::new(),
+            pair_const: Vec::new(),
             wall_slots: Vec::new(),
             wall_stride: 1,
             reference_position: p.position.clone(),
@@ -723,6 +940,7 @@ impl Simulation {
             needs_rebuild: true,
             csr_offset: vec![0; n + 1],
             csr_entry: Vec::new(),
+            pair_start: vec![0; n + 1],
             grid: CellGrid::default(),
             candidate_scratch: Vec::new(),
             old_pairs: Vec::new(),
@@ -793,30 +1011,59 @@ impl Simulation {
         }
     }
 
-    /// Gather lists (CSR): the pair indices of each particle in increasing order, tagged
-    /// with the side (bit 0: particle is j). A pure function of the pair list.
+    /// Gather lists: for each particle, the pairs where it is j (CSR, increasing pair index)
+    /// and the range of pairs where it is i (`pair_start`; the pair list is sorted by (i, j)).
+    /// Visiting the first, then the second, visits a particle's pairs in increasing index
+    /// order. A pure function of the pair list.
     pub(crate) fn build_gather_lists(&mut self) {
         let n = self.position.len();
         self.pair_out.clear();
         self.pair_out.resize(self.pairs.len(), PairOut::default());
         self.csr_offset.clear();
         self.csr_offset.resize(n + 1, 0);
+        self.pair_start.clear();
+        self.pair_start.resize(n + 1, 0);
         for p in &self.pairs {
-            self.csr_offset[p.i as usize + 1] += 1;
+            self.pair_start[p.i as usize + 1] += 1;
             self.csr_offset[p.j as usize + 1] += 1;
         }
         for i in 0..n {
+            self.pair_start[i + 1] += self.pair_start[i];
             self.csr_offset[i + 1] += self.csr_offset[i];
         }
         self.csr_entry.clear();
         self.csr_entry.resize(self.csr_offset[n] as usize, 0);
         let mut fill: Vec<u32> = self.csr_offset[..n].to_vec();
         for (k, p) in self.pairs.iter().enumerate() {
-            let e = (k as u32) << 1;
-            self.csr_entry[fill[p.i as usize] as usize] = e;
-            fill[p.i as usize] += 1;
-            self.csr_entry[fill[p.j as usize] as usize] = e | 1;
+            self.csr_entry[fill[p.j as usize] as usize] = k as u32;
             fill[p.j as usize] += 1;
+        }
+    }
+
+    /// Derived per-contact data: r_i + r_j of each pair and the law constants of every pair
+    /// and wall slot. A pure function of the lists and the static data (run after a rebuild
+    /// and a restore).
+    pub(crate) fn refresh_contact_constants(&mut self) {
+        let nm = self.n_materials;
+        self.pair_const.clear();
+        for p in self.pairs.iter_mut() {
+            let (i, j) = (p.i as usize, p.j as usize);
+            let r_sum = self.radius[i] + self.radius[j];
+            p.r_sum = r_sum;
+            let r_star = self.radius[i] * self.radius[j] / r_sum;
+            let m_star = self.mass[i] * self.mass[j] / (self.mass[i] + self.mass[j]);
+            let law = self.material[i] as usize * nm + self.material[j] as usize;
+            self.pair_const
+                .push(ContactConst::new(self.model, &self.laws, law, r_star, m_star));
+        }
+        let stride = self.wall_stride;
+        for (k, s) in self.wall_slots.iter_mut().enumerate() {
+            if s.wall == NO_WALL {
+                continue;
+            }
+            let i = k / stride;
+            let law = self.material[i] as usize * nm + self.walls[s.wall as usize].material;
+            s.k = ContactConst::new(self.model, &self.laws, law, self.radius[i], self.mass[i]);
         }
     }
 
@@ -915,6 +1162,7 @@ impl Simulation {
         for (k, ws) in self.wall_state.iter().enumerate() {
             self.reference_wall_offset[k] = ws.offset;
         }
+        self.refresh_contact_constants();
         self.needs_rebuild = false;
     }
 
@@ -959,72 +1207,112 @@ impl Simulation {
         if self.needs_rebuild {
             self.rebuild();
         }
-        // ---- pair phase
+        match self.effects.bits() {
+            TABLE => self.force_and_advance::<TABLE>(parallel),
+            TABLE_PLANAR => self.force_and_advance::<TABLE_PLANAR>(parallel),
+            _ => self.force_and_advance::<DYNAMIC>(parallel),
+        }
+        self.finish_step()
+    }
+
+    /// Pair phase and particle phase of one step, specialised on the effect set `E`.
+    fn force_and_advance<const E: u16>(&mut self, parallel: bool) {
+        let stride = self.wall_stride;
+        // rayon may split each parallel loop into at most about two tasks per thread: the step
+        // lasts microseconds, so fewer, larger tasks beat finer load balancing
+        let tasks = 2 * self.threads.max(1);
+        let pair_min = self.pairs.len().div_ceil(PAIR_CHUNK).div_ceil(tasks).max(1);
+        let particle_min = self.position.len().div_ceil(PARTICLE_CHUNK).div_ceil(tasks).max(1);
+        // ---- force phase: every pair and every wall slot writes its own record only
         {
-            let ctx = PairCtx {
+            let pair_ctx = PairCtx {
                 position: &self.position,
                 velocity: &self.velocity,
                 omega: &self.omega,
                 radius: &self.radius,
-                mass: &self.mass,
                 inertia: &self.inertia,
-                material: &self.material,
                 laws: &self.laws,
-                n_materials: self.n_materials,
                 model: self.model,
                 effects: self.effects,
                 clamp: self.clamp,
                 dt: self.dt,
             };
-            let kernel = |(chunk, out): (&mut [PairContact], &mut [PairOut])| -> u32 {
+            let wall_ctx = WallCtx {
+                position: &self.position,
+                velocity: &self.velocity,
+                omega: &self.omega,
+                alive: &self.alive,
+                radius: &self.radius,
+                inertia: &self.inertia,
+                walls: &self.walls,
+                wall_state: &self.wall_state,
+                laws: &self.laws,
+                model: self.model,
+                effects: self.effects,
+                clamp: self.clamp,
+                dt: self.dt,
+                wall_stride: stride,
+            };
+            let kernel = |((chunk, out), konst): (
+                (&mut [PairContact], &mut [PairOut]),
+                &[ContactConst],
+            )|
+             -> u32 {
                 let mut onsets = 0u32;
-                for (p, o) in chunk.iter_mut().zip(out.iter_mut()) {
-                    onsets += pair_kernel(p, o, &ctx) as u32;
+                for ((p, o), k) in chunk.iter_mut().zip(out.iter_mut()).zip(konst) {
+                    onsets += pair_kernel::<E>(p, k, o, &pair_ctx) as u32;
                 }
                 onsets
             };
+            let (pairs, pair_out, pair_const) =
+                (&mut self.pairs, &mut self.pair_out, &self.pair_const);
+            let (onsets, slots) = (&mut self.chunk_onsets, &mut self.wall_slots);
             if parallel {
-                self.pairs
-                    .par_chunks_mut(PAIR_CHUNK)
-                    .zip(self.pair_out.par_chunks_mut(PAIR_CHUNK))
-                    .map(kernel)
-                    .collect_into_vec(&mut self.chunk_onsets);
+                rayon::join(
+                    || {
+                        pairs
+                            .par_chunks_mut(PAIR_CHUNK)
+                            .zip(pair_out.par_chunks_mut(PAIR_CHUNK))
+                            .zip(pair_const.par_chunks(PAIR_CHUNK))
+                            .with_min_len(pair_min)
+                            .map(kernel)
+                            .collect_into_vec(onsets)
+                    },
+                    || {
+                        slots
+                            .par_chunks_mut(PARTICLE_CHUNK * stride)
+                            .enumerate()
+                            .with_min_len(particle_min)
+                            .for_each(|(c, s)| wall_chunk::<E>(&wall_ctx, c * PARTICLE_CHUNK, s))
+                    },
+                );
             } else {
-                self.chunk_onsets.clear();
-                let onsets = &mut self.chunk_onsets;
-                for chunk in self
-                    .pairs
+                onsets.clear();
+                for chunk in pairs
                     .chunks_mut(PAIR_CHUNK)
-                    .zip(self.pair_out.chunks_mut(PAIR_CHUNK))
+                    .zip(pair_out.chunks_mut(PAIR_CHUNK))
+                    .zip(pair_const.chunks(PAIR_CHUNK))
                 {
                     onsets.push(kernel(chunk));
                 }
+                wall_chunk::<E>(&wall_ctx, 0, slots);
             }
         }
-        // ---- particle phase
-        let stride = self.wall_stride;
+        // ---- particle phase: gather in list order, advance
         {
             let ctx = ParticleCtx {
                 pairs: &self.pairs,
                 pair_out: &self.pair_out,
                 csr_offset: &self.csr_offset,
                 csr_entry: &self.csr_entry,
+                pair_start: &self.pair_start,
                 radius: &self.radius,
-                mass: &self.mass,
                 inv_mass: &self.inv_mass,
-                inertia: &self.inertia,
                 inv_inertia: &self.inv_inertia,
-                material: &self.material,
                 alive: &self.alive,
                 reference_position: &self.reference_position,
-                walls: &self.walls,
-                wall_state: &self.wall_state,
-                laws: &self.laws,
-                n_materials: self.n_materials,
-                model: self.model,
                 effects: self.effects,
                 gravity: self.gravity,
-                clamp: self.clamp,
                 dt: self.dt,
                 wall_stride: stride,
             };
@@ -1036,10 +1324,11 @@ impl Simulation {
                     .zip(self.contact_force_sum.par_chunks_mut(PARTICLE_CHUNK))
                     .zip(self.coordination.par_chunks_mut(PARTICLE_CHUNK))
                     .zip(self.wall_coordination.par_chunks_mut(PARTICLE_CHUNK))
-                    .zip(self.wall_slots.par_chunks_mut(PARTICLE_CHUNK * stride))
+                    .zip(self.wall_slots.par_chunks(PARTICLE_CHUNK * stride))
                     .enumerate()
+                    .with_min_len(particle_min)
                     .map(|(c, ((((((x, v), w), f), z), zw), s))| {
-                        particle_chunk(&ctx, c * PARTICLE_CHUNK, x, v, w, f, z, zw, s)
+                        particle_chunk::<E>(&ctx, c * PARTICLE_CHUNK, x, v, w, f, z, zw, s)
                     })
                     .collect_into_vec(&mut self.chunk_results);
             } else {
@@ -1052,10 +1341,10 @@ impl Simulation {
                     .zip(self.contact_force_sum.chunks_mut(PARTICLE_CHUNK))
                     .zip(self.coordination.chunks_mut(PARTICLE_CHUNK))
                     .zip(self.wall_coordination.chunks_mut(PARTICLE_CHUNK))
-                    .zip(self.wall_slots.chunks_mut(PARTICLE_CHUNK * stride))
+                    .zip(self.wall_slots.chunks(PARTICLE_CHUNK * stride))
                     .enumerate();
                 for (c, ((((((x, v), w), f), z), zw), s)) in iter {
-                    self.chunk_results.push(particle_chunk(
+                    self.chunk_results.push(particle_chunk::<E>(
                         &ctx,
                         c * PARTICLE_CHUNK,
                         x,
@@ -1069,6 +1358,10 @@ impl Simulation {
                 }
             }
         }
+    }
+
+    /// End of a step: reduce the chunk results, log onsets, advance time, decide the rebuild.
+    fn finish_step(&mut self) -> Result<()> {
         let mut max_disp2: f64 = 0.0;
         let mut bad = false;
         let mut wall_onsets = 0u32;
