@@ -9,7 +9,7 @@ import numpy as np
 
 from demfem.errors import DemfemError
 
-__all__ = ["main"]
+__all__ = ["main", "build_parser", "study_options_from_args"]
 
 
 def _cmd_calibrate(args: argparse.Namespace) -> int:
@@ -65,7 +65,9 @@ _STUDY_DEFAULTS = {
 }
 
 
-def _study_options(args: argparse.Namespace):
+def study_options_from_args(args: argparse.Namespace):
+    """The :class:`demfem.studies.figures.StudyOptions` of a parsed `demfem figN` command line
+    (used by the scripts in examples/ too)."""
     from pathlib import Path
 
     from demfem.studies.figures import StudyOptions
@@ -90,7 +92,7 @@ def _study_options(args: argparse.Namespace):
 def _cmd_study(args: argparse.Namespace) -> int:
     from demfem.studies import figures
 
-    opts = _study_options(args)
+    opts = study_options_from_args(args)
     if args.command == "fig5":
         result = figures.fig5(opts, discard_before=args.discard_before)
         print(f"gentlest set-up: {result['gentlest']} (paper: A=2cm T=2s V=0.2m/s)")
@@ -99,7 +101,7 @@ def _cmd_study(args: argparse.Namespace) -> int:
     elif args.command == "fig7":
         figures.fig7(opts, stiff_duration=args.stiff_duration)
     else:
-        figures.fig8_9(opts)
+        figures.fig8_9(opts, snapshot_times=tuple(float(x) for x in args.snapshots.split(",")))
     print(f"figures in {opts.out}")
     return 0
 
@@ -157,8 +159,10 @@ def build_parser() -> argparse.ArgumentParser:
         f.add_argument("--stiff-duration", type=float, default=None,
                        help="simulated time for the runs with E > 1e9 Pa, s (default: "
                             "--duration)")
-    _add_study(sub, "fig8", "Figs. 8-9: triangular centre and first line, snapshots, GIF "
-               "and ParaView series")
+    f8 = _add_study(sub, "fig8", "Figs. 8-9: triangular centre and first line, snapshots, GIF "
+                    "and ParaView series")
+    f8.add_argument("--snapshots", default="9.3,12.2", metavar="T1,T2,...",
+                    help="times of the table snapshots, s (9.3,12.2; clipped to the run)")
     return p
 
 

@@ -101,6 +101,32 @@ def test_checkpoint_resume_matches_uninterrupted_run(tiny_run, tmp_path):
     assert resumed.info["steps"] == tiny_run.info["steps"]
 
 
+def test_mismatched_checkpoint_pair_starts_afresh(tiny_run, tmp_path):
+    """A crash between the two renames leaves an engine state and a record of different
+    times: the run must notice and start again rather than splice them."""
+    import shutil
+
+    ckpt = tmp_path / "run.ckpt"
+    record = tmp_path / "run.ckpt.record.npz"
+
+    def stop_after(limit):
+        def progress(sim_time, steps):
+            if sim_time > limit:
+                raise _Stop
+        return progress
+
+    for limit in (0.05, 0.15):
+        with pytest.raises(_Stop):
+            run_table(AccumulationTable(**TINY), 0.4, sample_interval=0.02, checkpoint=ckpt,
+                      checkpoint_every=1e-9, progress=stop_after(limit))
+        if limit == 0.05:
+            shutil.copy(record, tmp_path / "old.npz")
+    shutil.copy(tmp_path / "old.npz", record)  # engine at ~0.16 s, record up to ~0.06 s
+    resumed = run_table(AccumulationTable(**TINY), 0.4, sample_interval=0.02, checkpoint=ckpt)
+    np.testing.assert_array_equal(resumed.positions, tiny_run.positions)
+    assert resumed.n_frames == tiny_run.n_frames
+
+
 def test_run_table_rejects_bad_arguments():
     table = AccumulationTable(**TINY)
     with pytest.raises(InvalidParameterError, match="duration"):

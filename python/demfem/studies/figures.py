@@ -403,7 +403,7 @@ def fig8_9(opts: StudyOptions, snapshot_times: Sequence[float] = (9.3, 12.2),
 
     stride = max(1, int(round(animation_interval / (t[1] - t[0]))))
     gif = animate_table(opts.out / "movie1_table.gif", scene, run.positions[::stride],
-                        t[::stride], fps=10, dpi=60)
+                        t[::stride].tolist(), fps=10, dpi=60)
     pvd = _write_vtk_series(opts.out / "vtk", run, vtk_interval)
 
     present_tri = np.isfinite(s_tri)

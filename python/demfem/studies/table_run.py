@@ -31,6 +31,7 @@ from demfem.analysis.forces import first_line_force, force_statistics
 from demfem.analysis.coordination import mean_coordination
 from demfem.errors import DemfemIOError, InvalidParameterError
 from demfem.io.atomic import atomic_path
+from demfem.progress import ProgressBar
 from demfem.scenes.table import AccumulationTable
 
 __all__ = ["TableRun", "run_table", "sweep_point", "table_from_params", "RUN_OPTIONS"]
@@ -257,11 +258,12 @@ class _Recorder:
         return table[np.argsort(table["time"], kind="stable")]
 
     def save_partial(self, path: Path) -> None:
-        arrays = {f"frame_{k}": v for k, v in self.stacked().items()}
+        arrays: dict[str, Any] = {f"frame_{k}": v for k, v in self.stacked().items()}
         arrays.update({f"onset_{k}": v for k, v in self.raw_onsets().items()})
+        arrays["removal_times"] = self.removal_times
         with atomic_path(path, suffix=".npz") as tmp:
             with open(tmp, "wb") as fh:
-                np.savez(fh, removal_times=self.removal_times, **arrays)
+                np.savez(fh, **arrays)
 
     def load_partial(self, path: Path) -> None:
         with np.load(path, allow_pickle=False) as data:
@@ -330,13 +332,18 @@ def run_table(table: AccumulationTable, duration: float, sample_interval: float 
     rec = _Recorder(len(scene.radii))
     wall_before = 0.0
     ckpt = Path(checkpoint) if checkpoint is not None else None
-    record_file = Path(str(ckpt) + ".record.npz") if ckpt is not None else None
-    if ckpt is not None and ckpt.exists() and record_file.exists():
-        sim.load_checkpoint(ckpt)
-        rec.load_partial(record_file)
-        wall_before = float(json.loads(Path(str(ckpt) + ".json").read_text())["wall_time_s"]) \
-            if Path(str(ckpt) + ".json").exists() else 0.0
-    else:
+    files = _checkpoint_files(ckpt) if ckpt is not None else None
+    if files is not None and all(p.exists() for p in files[:2]):
+        sim.load_checkpoint(files[0])
+        rec.load_partial(files[1])
+        if files[2].exists():
+            wall_before = float(json.loads(files[2].read_text())["wall_time_s"])
+        if not math.isclose(float(rec.frames["times"][-1]), float(sim.time), rel_tol=0.0,
+                            abs_tol=0.5 * float(sim.dt)):
+            # A crash between the renames of a checkpoint: the pair does not belong together.
+            sim = from_scene(scene, model=model, threads=threads, record_onsets=True, dt=dt)
+            rec, wall_before = _Recorder(len(scene.radii)), 0.0
+    if not rec.frames["times"]:
         rec.sample(sim, table)
     start = _time.perf_counter()
     last_checkpoint = start
@@ -350,8 +357,8 @@ def run_table(table: AccumulationTable, duration: float, sample_interval: float 
         if progress is not None:
             progress(float(sim.time), int(sim.steps))
         now = _time.perf_counter()
-        if ckpt is not None and now - last_checkpoint >= checkpoint_every and k <= n_samples:
-            _write_checkpoint(sim, rec, ckpt, record_file, wall_before + now - start)
+        if files is not None and now - last_checkpoint >= checkpoint_every and k <= n_samples:
+            _write_checkpoint(sim, rec, files, wall_before + now - start)
             last_checkpoint = now
     frames = rec.stacked()
     run = TableRun(
@@ -366,27 +373,35 @@ def run_table(table: AccumulationTable, duration: float, sample_interval: float 
               "wall_time_s": wall_before + _time.perf_counter() - start},
         **frames,
     )
-    if ckpt is not None:
-        for p in (ckpt, record_file, Path(str(ckpt) + ".json")):
+    if files is not None:
+        for p in files:
             p.unlink(missing_ok=True)
     return run
 
 
-def _write_checkpoint(sim, rec: _Recorder, ckpt: Path, record_file: Path,
+def _checkpoint_files(ckpt: Path) -> tuple[Path, Path, Path]:
+    """The engine checkpoint, the record so far (``.record.npz``) and the wall time used
+    (``.json``)."""
+    return ckpt, Path(str(ckpt) + ".record.npz"), Path(str(ckpt) + ".json")
+
+
+def _write_checkpoint(sim, rec: _Recorder, files: tuple[Path, Path, Path],
                       wall_time: float) -> None:
-    """Engine state, record so far and wall time used; the record goes first, so a crash in
-    between leaves a record one checkpoint ahead, which the next run overwrites."""
+    """Engine state, record so far and wall time used. Each file is replaced atomically; a
+    crash between the two renames leaves an engine state and a record of different times,
+    which :func:`run_table` detects (the record's last sample time is the engine's time) and
+    then starts afresh."""
     from demfem.io.atomic import write_text_atomic
 
+    ckpt, record_file, wall_file = files
     ckpt.parent.mkdir(parents=True, exist_ok=True)
-    # Engine checkpoint first into a temporary name, then the record, then both renames:
-    # the pair on disk always belongs together.
+    # Both written in full under temporary names first, then renamed one after the other.
     tmp_ckpt = ckpt.with_name(ckpt.name + ".new")
     sim.save_checkpoint(tmp_ckpt)
     rec.save_partial(record_file.with_name(record_file.name + ".new.npz"))
     os.replace(tmp_ckpt, ckpt)
     os.replace(record_file.with_name(record_file.name + ".new.npz"), record_file)
-    write_text_atomic(Path(str(ckpt) + ".json"), json.dumps({"wall_time_s": wall_time}))
+    write_text_atomic(wall_file, json.dumps({"wall_time_s": wall_time}))
 
 
 # --------------------------------------------------------------------------------------------
@@ -437,11 +452,16 @@ def sweep_point(params: Mapping[str, Any]) -> dict[str, Any]:
     run_dir = params.get("run_dir")
     key = run_key(dict(params))
     checkpoint = Path(run_dir) / f"{key}.ckpt" if run_dir else None
-    run = run_table(table, float(params["duration"]),
+    duration = float(params["duration"])
+    # On a worker, stderr goes to the sweep's log: one progress line a minute.
+    bar = ProgressBar(duration, label=key[:48], log_interval=60.0)
+    run = run_table(table, duration,
                     sample_interval=float(params.get("sample_interval", 0.05)),
                     model=str(params.get("model", "hertz_reissner_mindlin")),
                     checkpoint=checkpoint,
-                    checkpoint_every=float(params.get("checkpoint_every", 300.0)))
+                    checkpoint_every=float(params.get("checkpoint_every", 300.0)),
+                    progress=bar)
+    bar.close()
     result: dict[str, Any] = run.summary(float(params.get("discard_before", 0.0)),
                                          float(params.get("quantile", 0.95)))
     result["run_file"] = ""
