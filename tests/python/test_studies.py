@@ -62,6 +62,18 @@ def test_onsets_carry_partner_coordination(tiny_run):
                                                              o["normal_speed"]))
 
 
+def test_first_line_force_parts(tiny_run):
+    total = tiny_run.first_line_force()
+    plane = tiny_run.first_line_force("in_plane")
+    ok = np.isfinite(total)
+    assert ok.sum() > 10 and np.all(plane[ok] <= total[ok] + 1e-15)
+    # a sphere resting on the belt carries its weight: the total force is about m g
+    weight = AccumulationTable(**TINY).sphere_mass * 9.81
+    assert np.nanmedian(total[5:]) == pytest.approx(weight, rel=0.5)
+    with pytest.raises(InvalidParameterError, match="part"):
+        tiny_run.first_line_force("vertical")
+
+
 def test_save_load_round_trip(tiny_run, tmp_path):
     path = tiny_run.save(tmp_path / "run.npz")
     back = TableRun.load(path)
@@ -221,4 +233,5 @@ def test_cli_fig5_quick(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "gentlest set-up:" in out and (tmp_path / "fig5_first_line_force.png").exists()
     lines = (tmp_path / "fig5_ranking.csv").read_text().strip().splitlines()
-    assert len(lines) == 1 + 10  # 9 distinct set-ups of the three panels + the paper's choice
+    # 9 distinct set-ups of the three panels + the paper's choice, ranked in-plane and total
+    assert len(lines) == 1 + 2 * 10

@@ -111,9 +111,20 @@ class TableRun:
         """(F, N) bool: sphere still on the table at each sample."""
         return np.all(np.isfinite(self.positions), axis=2)
 
-    def first_line_force(self) -> np.ndarray:
-        """(F,) mean force magnitude on the first-line spheres, N (paper Fig. 5)."""
-        return first_line_force(self.forces, self.tags)
+    def first_line_force(self, part: str = "total") -> np.ndarray:
+        """(F,) mean magnitude of the net contact force on the first-line spheres, N (paper
+        Fig. 5).
+
+        ``part="total"``: the whole net contact force, as Yade's ``O.forces.f`` that the paper
+        plots; for a sphere on the belt it contains the belt's support, about m g = 0.048 N,
+        the same in every set-up. ``part="in_plane"``: only its horizontal (x, y) part, the
+        push of the neighbours, walls and belt friction along the table.
+        """
+        if part == "total":
+            return first_line_force(self.forces, self.tags)
+        if part == "in_plane":
+            return first_line_force(np.linalg.norm(self.forces[..., :2], axis=2), self.tags)
+        raise InvalidParameterError(f"invalid part = {part!r}: must be 'total' or 'in_plane'")
 
     def mean_coordination(self, select: Optional[np.ndarray] = None) -> np.ndarray:
         """(F,) mean coordination of the present spheres (all, or a mask / index selection)."""
@@ -154,15 +165,19 @@ class TableRun:
 
     def summary(self, discard_before: float = 0.0, quantile: float = 0.95) -> dict[str, float]:
         """Numbers for a sweep table: first-line force mean / peak / quantile (N) after
-        ``discard_before`` (s), mean coordination of the present spheres, spheres removed,
+        ``discard_before`` (s), total and in-plane (see :meth:`first_line_force`), mean coordination of the present spheres, spheres removed,
         spheres riding up at the end, largest overlap (m)."""
         keep = self.times >= discard_before
         stats = force_statistics(self.first_line_force()[keep], quantile)
+        plane = force_statistics(self.first_line_force("in_plane")[keep], quantile)
         z = self.mean_coordination()
         return {
             "force_mean_N": stats["mean"],
             "force_peak_N": stats["peak"],
             "force_q95_N" if quantile == 0.95 else f"force_q{quantile:g}_N": stats["quantile"],
+            "in_plane_force_mean_N": plane["mean"],
+            "in_plane_force_peak_N": plane["peak"],
+            "in_plane_force_quantile_N": plane["quantile"],
             "coordination_mean": float(np.nanmean(z[keep])),
             "n_removed": int(np.isfinite(self.removal_times).sum()),
             "riding_up_end": int(self.riding_up[-1]),
