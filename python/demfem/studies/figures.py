@@ -106,7 +106,9 @@ def _sweep_runs(opts: StudyOptions, grid: dict[str, list[Any]], duration: float,
 
     runs_dir = opts.out / "runs"
     fixed = {**SWEEP_GEOMETRY, **(opts.table or {}), "duration": float(duration),
-             "sample_interval": float(opts.sample_interval), "run_dir": str(runs_dir)}
+             "sample_interval": float(opts.sample_interval),
+             # absolute, so that `--out s` and `--out /abs/s` name (and reuse) the same runs
+             "run_dir": str(runs_dir.resolve())}
 
     def progress(done: int, total: int) -> None:
         opts.log(f"  {label}: runs finished {done}/{total}")
