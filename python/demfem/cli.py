@@ -114,7 +114,7 @@ def _add_study(sub, name: str, help_text: str) -> argparse.ArgumentParser:
     s.add_argument("--E", default=None, metavar="E1,E2,...",
                    help=f"Young's modulus/moduli, Pa ({moduli})")
     s.add_argument("--quick", action="store_true",
-                   help="a short smoke run (seconds) with the same outputs")
+                   help="a smoke run (0.3 s simulated per run) with the same outputs")
     s.add_argument("--sample-interval", type=float, default=None,
                    help="time between recorded samples, s (0.05; --quick: 0.02)")
     s.add_argument("--out", default="demfem_out/studies",
