@@ -9,7 +9,7 @@ import numpy as np
 
 from demfem.errors import DemfemError
 
-__all__ = ["main"]
+__all__ = ["main", "build_parser", "study_options_from_args"]
 
 
 def _cmd_calibrate(args: argparse.Namespace) -> int:
@@ -56,6 +56,76 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     return 0
 
 
+#: Defaults of the figure studies: (duration s, moduli Pa) for a full run and for --quick.
+_STUDY_DEFAULTS = {
+    "fig5": ((10.0, "1e7"), (0.3, "1e7")),
+    "fig6": ((8.0, "1e7,1e8,1e9"), (0.3, "1e7,1e8")),
+    "fig7": ((8.0, "1e7,1e8,1e9"), (0.3, "1e7,1e8")),
+    "fig8": ((10.0, "1e7"), (0.3, "1e7")),
+}
+
+
+def study_options_from_args(args: argparse.Namespace):
+    """The :class:`demfem.studies.figures.StudyOptions` of a parsed `demfem figN` command line
+    (used by the scripts in examples/ too)."""
+    from pathlib import Path
+
+    from demfem.studies.figures import StudyOptions
+
+    (duration, moduli), (q_duration, q_moduli) = _STUDY_DEFAULTS[args.command]
+    if args.quick:
+        duration, moduli = q_duration, q_moduli
+    duration = args.duration if args.duration is not None else duration
+    text = args.E if args.E is not None else moduli
+    try:
+        values = tuple(float(x) for x in text.split(","))
+    except ValueError:
+        raise ValueError(f"invalid --E {text!r}: must be Young's moduli in Pa, comma "
+                         "separated, e.g. 1e7,1e8") from None
+    sample = args.sample_interval if args.sample_interval is not None else (
+        0.02 if args.quick else 0.05)
+    return StudyOptions(out=Path(args.out), duration=duration, moduli=values,
+                        sample_interval=sample, scheduler=args.scheduler,
+                        workers=args.workers)
+
+
+def _cmd_study(args: argparse.Namespace) -> int:
+    from demfem.studies import figures
+
+    opts = study_options_from_args(args)
+    if args.command == "fig5":
+        result = figures.fig5(opts, discard_before=args.discard_before)
+        print(f"gentlest set-up: {result['gentlest']} (paper: A=2cm T=2s V=0.2m/s)")
+    elif args.command == "fig6":
+        figures.fig6(opts, stiff_duration=args.stiff_duration)
+    elif args.command == "fig7":
+        figures.fig7(opts, stiff_duration=args.stiff_duration)
+    else:
+        figures.fig8_9(opts, snapshot_times=tuple(float(x) for x in args.snapshots.split(",")))
+    print(f"figures in {opts.out}")
+    return 0
+
+
+def _add_study(sub, name: str, help_text: str) -> argparse.ArgumentParser:
+    (duration, moduli), (q_duration, _) = _STUDY_DEFAULTS[name]
+    s = sub.add_parser(name, help=help_text)
+    s.add_argument("--duration", type=float, default=None,
+                   help=f"simulated time per run, s ({duration:g}; --quick: {q_duration:g})")
+    s.add_argument("--E", default=None, metavar="E1,E2,...",
+                   help=f"Young's modulus/moduli, Pa ({moduli})")
+    s.add_argument("--quick", action="store_true",
+                   help="a smoke run (0.3 s simulated per run) with the same outputs")
+    s.add_argument("--sample-interval", type=float, default=None,
+                   help="time between recorded samples, s (0.05; --quick: 0.02)")
+    s.add_argument("--out", default="demfem_out/studies",
+                   help="output folder; runs are kept in <out>/runs and reused")
+    s.add_argument("--scheduler", default=None,
+                   help="Dask scheduler address, or 'serial'; default: a LocalCluster")
+    s.add_argument("--workers", type=int, default=None, help="LocalCluster worker processes")
+    s.set_defaults(func=_cmd_study)
+    return s
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``demfem`` command."""
     p = argparse.ArgumentParser(prog="demfem", description="DEM-FEM breakage of glass cartridges "
@@ -79,6 +149,20 @@ def build_parser() -> argparse.ArgumentParser:
                         "default: a LocalCluster on this machine")
     s.add_argument("--workers", type=int, default=None, help="LocalCluster worker processes")
     s.set_defaults(func=_cmd_sweep)
+    f5 = _add_study(sub, "fig5", "Fig. 5: first-line force for A, T, V_belt and the gentlest "
+                    "set-up")
+    f5.add_argument("--discard-before", type=float, default=1.0,
+                    help="start of the force statistics used for the ranking, s (1)")
+    for name, text in (("fig6", "Fig. 6: coordination number against time for several E"),
+                       ("fig7", "Fig. 7: rectangular-centre speed against time for several E")):
+        f = _add_study(sub, name, text)
+        f.add_argument("--stiff-duration", type=float, default=None,
+                       help="simulated time for the runs with E > 1e9 Pa, s (default: "
+                            "--duration)")
+    f8 = _add_study(sub, "fig8", "Figs. 8-9: triangular centre and first line, snapshots, GIF "
+                    "and ParaView series")
+    f8.add_argument("--snapshots", default="9.3,12.2", metavar="T1,T2,...",
+                    help="times of the table snapshots, s (9.3,12.2; clipped to the run)")
     return p
 
 

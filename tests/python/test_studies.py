@@ -1,0 +1,237 @@
+"""Studies: recorded table runs, checkpoint/resume, the sweep runner, the figure functions."""
+import json
+import math
+
+import numpy as np
+import pytest
+
+from demfem.cli import main
+from demfem.errors import InvalidParameterError
+from demfem.scenes import AccumulationTable, Tag
+from demfem.studies import TableRun, run_table, sweep_point, table_from_params
+from demfem.studies import figures
+from demfem.sweep import run_key
+
+#: A table of 30 spheres that empties a little through a fast gate within 0.4 s at E = 1e7 Pa.
+TINY = dict(width=0.1, length=0.1, tilted_wall_length=0.08, opening_width=0.03,
+            gate_amplitude=0.01, gate_period=0.2, belt_velocity=0.5, young_modulus=1e7,
+            n_spheres=30)
+
+
+@pytest.fixture(scope="module")
+def tiny_run():
+    return run_table(AccumulationTable(**TINY), 0.4, sample_interval=0.02)
+
+
+def test_run_table_records_consistent_shapes(tiny_run):
+    run = tiny_run
+    f, n = 21, 30
+    assert run.n_frames == f and run.n_particles == n
+    np.testing.assert_allclose(run.times, 0.02 * np.arange(f), atol=run.info["dt"])
+    for name, shape in (("positions", (f, n, 3)), ("velocities", (f, n, 3)),
+                        ("forces", (f, n, 3)), ("coordination", (f, n)), ("opening", (f,)),
+                        ("riding_up", (f,)), ("max_overlap", (f,))):
+        assert getattr(run, name).shape == shape, name
+    np.testing.assert_allclose(run.opening, AccumulationTable(**TINY).opening_width_at(run.times))
+    assert np.array_equal(run.tags, AccumulationTable(**TINY).build().tags)
+    # removed spheres: NaN from the first sample after their removal on, finite before
+    removed = np.flatnonzero(np.isfinite(run.removal_times))
+    assert len(removed) >= 1
+    for i in removed:
+        after = run.times >= run.removal_times[i]
+        assert np.all(np.isnan(run.positions[after, i])) and np.all(np.isnan(run.velocities[after, i]))
+        assert np.all(np.isnan(run.coordination[after, i])) and np.all(np.isnan(run.forces[after, i]))
+        assert np.all(np.isfinite(run.positions[~after, i]))
+    kept = np.setdiff1d(np.arange(n), removed)
+    assert np.all(np.isfinite(run.positions[:, kept])) and np.all(run.coordination[:, kept] >= 0)
+    assert run.present.sum(axis=1)[-1] == n - len(removed)
+
+
+def test_onsets_carry_partner_coordination(tiny_run):
+    o = tiny_run.onsets
+    assert len(o) > 10
+    assert np.all(np.diff(o["time"]) >= 0) and np.all(o["i"] != o["j"])
+    assert np.all((o["i"] < 30) & (o["j"] < 30))
+    # the coordination of both partners is the one recorded at the nearest sample
+    k = np.rint(o["time"] / 0.02).astype(int)
+    for row, frame in zip(o[:50], k[:50]):
+        for who, z in (("i", row["coordination_i"]), ("j", row["coordination_j"])):
+            recorded = tiny_run.coordination[frame, row[who]]
+            assert z == (recorded if np.isfinite(recorded) else -1)
+    np.testing.assert_allclose(o["impact_angle"], np.arctan2(o["tangential_speed"],
+                                                             o["normal_speed"]))
+
+
+def test_first_line_force_parts(tiny_run):
+    total = tiny_run.first_line_force()
+    plane = tiny_run.first_line_force("in_plane")
+    ok = np.isfinite(total)
+    assert ok.sum() > 10 and np.all(plane[ok] <= total[ok] + 1e-15)
+    # a sphere resting on the belt carries its weight: the total force is about m g
+    weight = AccumulationTable(**TINY).sphere_mass * 9.81
+    assert np.nanmedian(total[5:]) == pytest.approx(weight, rel=0.5)
+    with pytest.raises(InvalidParameterError, match="part"):
+        tiny_run.first_line_force("vertical")
+
+
+def test_save_load_round_trip(tiny_run, tmp_path):
+    path = tiny_run.save(tmp_path / "run.npz")
+    back = TableRun.load(path)
+    for name in ("times", "positions", "velocities", "coordination", "forces", "opening",
+                 "tags", "radii", "removal_times", "riding_up", "max_overlap"):
+        np.testing.assert_array_equal(getattr(back, name), getattr(tiny_run, name))
+    assert np.array_equal(back.onsets, tiny_run.onsets) and back.onsets.dtype == tiny_run.onsets.dtype
+    assert back.parameters == tiny_run.parameters and back.table == AccumulationTable(**TINY)
+    assert back.info == json.loads(json.dumps(tiny_run.info))
+    np.testing.assert_array_equal(back.first_line_force(), tiny_run.first_line_force())
+    with pytest.raises(InvalidParameterError, match="invalid table run file"):
+        np.savez(tmp_path / "bad.npz", times=np.zeros(2))
+        TableRun.load(tmp_path / "bad.npz")
+
+
+class _Stop(Exception):
+    pass
+
+
+def test_checkpoint_resume_matches_uninterrupted_run(tiny_run, tmp_path):
+    ckpt = tmp_path / "run.ckpt"
+
+    def stop_at_a_quarter(sim_time, steps):
+        if sim_time > 0.1:
+            raise _Stop
+
+    with pytest.raises(_Stop):
+        run_table(AccumulationTable(**TINY), 0.4, sample_interval=0.02, checkpoint=ckpt,
+                  checkpoint_every=1e-9, progress=stop_at_a_quarter)
+    assert ckpt.exists()
+    resumed = run_table(AccumulationTable(**TINY), 0.4, sample_interval=0.02, checkpoint=ckpt)
+    assert not ckpt.exists()  # cleaned up once finished
+    for name in ("times", "positions", "velocities", "coordination", "forces",
+                 "removal_times"):
+        np.testing.assert_array_equal(getattr(resumed, name), getattr(tiny_run, name))
+    assert np.array_equal(resumed.onsets, tiny_run.onsets)
+    assert resumed.info["steps"] == tiny_run.info["steps"]
+
+
+def test_mismatched_checkpoint_pair_starts_afresh(tiny_run, tmp_path):
+    """A crash between the two renames leaves an engine state and a record of different
+    times: the run must notice and start again rather than splice them."""
+    import shutil
+
+    ckpt = tmp_path / "run.ckpt"
+    record = tmp_path / "run.ckpt.record.npz"
+
+    def stop_after(limit):
+        def progress(sim_time, steps):
+            if sim_time > limit:
+                raise _Stop
+        return progress
+
+    for limit in (0.05, 0.15):
+        with pytest.raises(_Stop):
+            run_table(AccumulationTable(**TINY), 0.4, sample_interval=0.02, checkpoint=ckpt,
+                      checkpoint_every=1e-9, progress=stop_after(limit))
+        if limit == 0.05:
+            shutil.copy(record, tmp_path / "old.npz")
+    shutil.copy(tmp_path / "old.npz", record)  # engine at ~0.16 s, record up to ~0.06 s
+    resumed = run_table(AccumulationTable(**TINY), 0.4, sample_interval=0.02, checkpoint=ckpt)
+    np.testing.assert_array_equal(resumed.positions, tiny_run.positions)
+    assert resumed.n_frames == tiny_run.n_frames
+
+
+def test_run_table_rejects_bad_arguments():
+    table = AccumulationTable(**TINY)
+    with pytest.raises(InvalidParameterError, match="duration"):
+        run_table(table, -1.0)
+    with pytest.raises(InvalidParameterError, match="sample_interval"):
+        run_table(table, 0.1, sample_interval=0.2)
+    with pytest.raises(InvalidParameterError, match="threads"):
+        run_table(table, 0.1, threads=0)
+
+
+def test_sweep_point_returns_summary_and_saves_the_run(tmp_path):
+    params = {**TINY, "duration": 0.1, "sample_interval": 0.02, "run_dir": str(tmp_path)}
+    result = sweep_point(params)
+    for key in ("force_mean_N", "force_peak_N", "force_q95_N", "coordination_mean",
+                "n_removed", "riding_up_end", "max_overlap_m", "sim_wall_time_s", "run_file"):
+        assert key in result, key
+    assert result["force_peak_N"] >= result["force_q95_N"] >= 0
+    assert result["run_file"] == str(tmp_path / f"{run_key(params)}.npz")
+    run = TableRun.load(result["run_file"])
+    assert run.n_frames == 6 and math.isclose(result["force_mean_N"],
+                                              float(np.nanmean(run.first_line_force())))
+    with pytest.raises(InvalidParameterError, match="duration"):
+        sweep_point(TINY)
+    with pytest.raises(InvalidParameterError, match="unknown key 'belt_speed'"):
+        sweep_point({**TINY, "duration": 0.1, "belt_speed": 0.2})
+
+
+def test_narrowest_opening_keeps_the_smallest_gap():
+    base = {k: v for k, v in TINY.items() if k != "opening_width"}
+    table = table_from_params({**base, "gate_amplitude": 0.015, "narrowest_opening": 0.01})
+    assert math.isclose(table.opening_width, 0.025) and math.isclose(table.min_opening_width, 0.01)
+    with pytest.raises(InvalidParameterError, match="narrowest_opening or opening_width"):
+        table_from_params({**TINY, "narrowest_opening": 0.01})
+
+
+#: Small table for the figure functions: Fig. 6-9 set-ups need an opening up to 6 cm.
+SMALL_FIG = dict(width=0.1, length=0.1, tilted_wall_length=0.05, n_spheres=30)
+
+
+def _opts(tmp_path, moduli=(1e7,), duration=0.2):
+    return figures.StudyOptions(out=tmp_path, duration=duration, moduli=moduli,
+                                sample_interval=0.02, scheduler="serial", log=lambda s: None,
+                                table=SMALL_FIG)
+
+
+def test_fig6_and_fig7_share_runs_and_write_figures(tmp_path):
+    found6 = figures.fig6(_opts(tmp_path, moduli=(1e7, 3e7)))
+    assert (tmp_path / "fig6_coordination.png").stat().st_size > 0
+    assert set(found6["groups"]) == {"all spheres", "first line", "rectangular centre"}
+    assert found6["mean_abs_difference_to_smallest_E"]["1e+07"] == 0.0
+    runs = sorted((tmp_path / "runs").glob("*.npz"))
+    assert len(runs) == 2
+    mtimes = [p.stat().st_mtime_ns for p in runs]
+    found7 = figures.fig7(_opts(tmp_path, moduli=(1e7, 3e7)))
+    assert [p.stat().st_mtime_ns for p in runs] == mtimes  # reused, not run again
+    assert (tmp_path / "fig7_rectangular_centre_speed.png").stat().st_size > 0
+    assert found7["1e+07"]["peak_speed_mm_s"] >= found7["1e+07"]["mean_speed_mm_s"] >= 0
+
+
+def test_fig8_9_writes_snapshots_animation_and_paraview_series(tmp_path):
+    found = figures.fig8_9(_opts(tmp_path), snapshot_times=(0.1, 5.0), vtk_interval=0.1)
+    for name in ("fig8_triangular_centre.png", "fig9_speed_and_coordination.png",
+                 "movie1_table.gif", "fig9_snapshot_0.1s.png", "fig9_snapshot_0.2s.png",
+                 "vtk/table.pvd", "vtk/table_00000.vtp", "vtk/table_00010.vtp"):
+        assert (tmp_path / name).stat().st_size > 0, name
+    assert found["duration_s"] == pytest.approx(0.2, abs=1e-3)
+    assert "table_00005.vtp" in (tmp_path / "vtk/table.pvd").read_text()
+
+
+def test_coordination_findings_measure_a_known_oscillation():
+    t = np.arange(0, 20, 0.05)
+    z = 5 + np.sin(2 * np.pi * t / 2.0)
+    f = figures.coordination_findings(t, z, 2.0, discard_before=2.0)
+    assert f["period_acf_s"] == pytest.approx(2.0, rel=0.02)
+    assert f["period_fft_s"] == pytest.approx(2.0, rel=0.05)
+    assert f["q05"] == pytest.approx(4.0, abs=0.05) and f["q95"] == pytest.approx(6.0, abs=0.05)
+
+
+def test_study_options_and_cli_errors(capsys):
+    with pytest.raises(InvalidParameterError, match="duration"):
+        figures.StudyOptions(out=".", duration=0.0, moduli=(1e7,))
+    with pytest.raises(InvalidParameterError, match="moduli"):
+        figures.StudyOptions(out=".", duration=1.0, moduli=())
+    assert main(["fig6", "--E", "ten", "--quick"]) == 2
+    assert "invalid --E 'ten'" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_cli_fig5_quick(tmp_path, capsys):
+    assert main(["fig5", "--quick", "--duration", "0.1", "--out", str(tmp_path),
+                 "--scheduler", "serial"]) == 0
+    out = capsys.readouterr().out
+    assert "gentlest set-up:" in out and (tmp_path / "fig5_first_line_force.png").exists()
+    lines = (tmp_path / "fig5_ranking.csv").read_text().strip().splitlines()
+    # 9 distinct set-ups of the three panels + the paper's choice, ranked in-plane and total
+    assert len(lines) == 1 + 2 * 10
