@@ -151,6 +151,10 @@ class DemSimulation:
     def riding_up_count(self, floor_z: float = 0.0, tolerance: float = 0.002) -> int:
         """Spheres whose centre is above floor_z + radius + tolerance (m)."""
     def remove_particle(self, i: int) -> None: ...
+    def reinsert_particle(
+        self, i: int, position: tuple[float, float, float], velocity: tuple[float, float, float]
+    ) -> None:
+        """Put removed particle i back at position (m) with velocity (m/s), no spin."""
     def frames(self) -> dict[str, npt.NDArray[Any]]:
         """time (F,), step (F,), positions/velocities/angular_velocities/contact_force_sums
         (F, N, 3), coordination/wall_contacts (F, N)."""

@@ -33,6 +33,7 @@ __all__ = [
     "constant_velocity",
     "run",
     "from_scene",
+    "refeed_removed",
     "CONTACT_MODELS",
 ]
 
@@ -126,10 +127,14 @@ def run(
     progress: Optional[Callable[[Progress], None]] = None,
     report_every: float = 1.0,
     chunk_steps: int = 2000,
+    refeed: Optional[dict[str, Any]] = None,
 ) -> int:
     """Advance ``sim`` to simulated time ``t_end`` (s); call ``progress`` about every
     ``report_every`` wall seconds. Returns the steps taken. Ctrl-C raises
-    ``SimulationInterrupted`` with the state consistent at a step boundary."""
+    ``SimulationInterrupted`` with the state consistent at a step boundary.
+
+    ``refeed``: a scene's ``{"sites": (k, 3) m, "velocity": (3,) m/s}``; after every chunk,
+    removed particles are put back at the first free sites (:func:`refeed_removed`)."""
     start_steps = sim.steps
     start_wall = _time.perf_counter()
     last_report = start_wall
@@ -139,6 +144,8 @@ def run(
         k = min(chunk_steps, total - done)
         sim.step(k, chunk=k)
         done += k
+        if refeed is not None:
+            refeed_removed(sim, refeed["sites"], refeed.get("velocity", (0.0, 0.0, 0.0)))
         now = _time.perf_counter()
         if progress is not None and (now - last_report >= report_every or done == total):
             last_report = now
@@ -178,6 +185,8 @@ def from_scene(
     thickness and body mid-surface radius); walls do not bend (infinite shell stiffness).
     ``dt`` (s) defaults to ``dt_safety`` times the stable limit; a larger one is refused.
     Contact onsets are logged (``record_onsets``) because the FEM load cases come from them.
+    A scene that re-feeds removed spheres (``scene.refeed``) is run with
+    ``run(sim, t, refeed=scene.refeed)`` or :func:`demfem.studies.run_table`.
     """
     import numpy as np
 
@@ -187,10 +196,6 @@ def from_scene(
 
     if model not in CONTACT_MODELS:
         raise InvalidParameterError(f"invalid model = {model!r}: must be one of {CONTACT_MODELS}")
-    if getattr(scene, "refeed", None):
-        raise InvalidParameterError(
-            "invalid refeed = True: the engine removes spheres through the outlet but cannot "
-            "re-insert them yet; run with refeed = False")
     mats = scene.materials
     pm = mats[scene.particle_material]
     # the engine derives masses from density and radius: they must be the scene's masses
@@ -259,3 +264,35 @@ def from_scene(
         threads=threads, record_every=record_every, record_onsets=record_onsets,
         removal_plane=removal_plane,
     )
+
+
+def refeed_removed(sim: DemSimulation, sites: Any, velocity: Vector = (0.0, 0.0, 0.0)) -> int:
+    """Put removed particles back, lowest index first, each at the first of ``sites``
+    ((k, 3) centres, m) where it touches no alive particle, with ``velocity`` (m/s) and no
+    spin. A particle for which no site is free waits for a later call. Returns how many
+    were put back."""
+    import numpy as np
+
+    alive = np.asarray(sim.alive(), dtype=bool)
+    dead = np.flatnonzero(~alive)
+    if dead.size == 0:
+        return 0
+    sites = np.asarray(sites, dtype=float).reshape(-1, 3)
+    vel = tuple(float(v) for v in velocity)
+    radii = np.asarray(sim.radii())
+    occupied = np.asarray(sim.positions())[alive]
+    occupied_r = radii[alive]
+    placed = 0
+    for i in dead:
+        for site in sites:
+            gap = np.linalg.norm(occupied - site, axis=1) - (occupied_r + radii[i])
+            if gap.size == 0 or gap.min() >= 0.0:
+                sim.reinsert_particle(int(i), (float(site[0]), float(site[1]), float(site[2])),
+                                      (vel[0], vel[1], vel[2]))
+                occupied = np.vstack([occupied, site])
+                occupied_r = np.append(occupied_r, radii[i])
+                placed += 1
+                break
+        else:
+            break  # every site is taken: the rest wait
+    return placed

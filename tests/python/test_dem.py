@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from demfem import dem
-from demfem.errors import EffectError, ShapeError, UnstableTimeStepError
+from demfem.errors import EffectError, InvalidParameterError, ShapeError, UnstableTimeStepError
 
 R = 0.008
 GLASS = dem.material(45e9, 0.22, 2230.0, friction=0.2, restitution=0.5)
@@ -95,3 +95,23 @@ def test_ctrl_c_stops_cleanly_at_a_chunk_boundary():
     assert sim.steps % 100 == 0 and 0 < sim.steps < 10_000_000
     assert np.isfinite(sim.positions()).all()
     sim.step(100)  # and the simulation goes on
+
+
+def test_refeed_puts_removed_spheres_back_upstream():
+    """A table that re-feeds keeps its population: spheres leaving through the opening are
+    re-inserted at free upstream sites, never on top of another sphere."""
+    from demfem.scenes import AccumulationTable
+
+    table = AccumulationTable(young_modulus=1e7, refeed=True, n_spheres=300)
+    scene = table.build()
+    sim = dem.from_scene(scene)
+    dem.run(sim, 3.0, refeed=scene.refeed)
+    times, removed = sim.removals()
+    assert len(removed) > 5  # spheres did leave
+    alive = sim.alive()
+    assert alive.sum() >= 300 - len(scene.refeed["sites"])  # and came back
+    pos, r = sim.positions()[alive], sim.radii()[alive]
+    d = np.linalg.norm(pos[:, None, :] - pos[None, :, :], axis=2) + np.eye(len(pos))
+    assert (d / (r[:, None] + r[None, :])).min() > 0.98  # no sphere placed inside another
+    with pytest.raises(InvalidParameterError, match="removed particle"):
+        sim.reinsert_particle(int(np.flatnonzero(alive)[0]), (0.1, 0.1, 0.1), (0, 0, 0))

@@ -334,7 +334,7 @@ def run_table(table: AccumulationTable, duration: float, sample_interval: float 
     Returns:
         The :class:`TableRun`.
     """
-    from demfem.dem import from_scene
+    from demfem.dem import from_scene, refeed_removed
 
     _check_run_arguments(duration, sample_interval, threads)
     if not (math.isfinite(checkpoint_every) and checkpoint_every > 0):
@@ -366,6 +366,8 @@ def run_table(table: AccumulationTable, duration: float, sample_interval: float 
     while k <= n_samples:
         # Steps are whole: advance to the first step at or after the sample time.
         sim.run_until(float(sample_times[k]))
+        if scene.refeed is not None:
+            refeed_removed(sim, scene.refeed["sites"], scene.refeed["velocity"])
         rec.collect_events(sim)
         rec.sample(sim, table)
         k += 1

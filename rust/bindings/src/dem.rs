@@ -528,6 +528,21 @@ impl DemSimulation {
         Ok(self.sim.remove_particle(i)?)
     }
 
+    /// Put removed particle `i` back at `position` (m) with `velocity` (m/s), no spin;
+    /// refused if it is alive, a value is not finite, or the site overlaps an alive particle.
+    fn reinsert_particle(
+        &mut self,
+        i: usize,
+        position: (f64, f64, f64),
+        velocity: (f64, f64, f64),
+    ) -> CoreResult<()> {
+        Ok(self.sim.reinsert_particle(
+            i,
+            Vec3::new(position.0, position.1, position.2),
+            Vec3::new(velocity.0, velocity.1, velocity.2),
+        )?)
+    }
+
     /// Recorded frames as a dict of stacked arrays: time (F,), step (F,), positions,
     /// velocities, angular_velocities, contact_force_sums (F, N, 3), coordination,
     /// wall_contacts (F, N).

@@ -1620,6 +1620,51 @@ impl Simulation {
         Ok(())
     }
 
+    /// Put removed particle `i` back at `position` (m) with `velocity` (m/s) and no spin, e.g.
+    /// to re-feed the table upstream. Refused if `i` is alive, if a value is not finite, or
+    /// if the particle would overlap an alive particle. Its contacts start afresh at the next neighbour-list rebuild,
+    /// which is forced.
+    pub fn reinsert_particle(&mut self, i: usize, position: Vec3, velocity: Vec3) -> Result<()> {
+        let n = self.position.len();
+        if i >= n {
+            return Err(DemfemError::invalid("particle index", i as f64, &format!("< {n}")));
+        }
+        if self.alive[i] {
+            return Err(DemfemError::invalid(
+                "particle index",
+                i as f64,
+                "a removed particle (this one is alive)",
+            ));
+        }
+        if !(position.is_finite() && velocity.is_finite()) {
+            return Err(DemfemError::InvalidParameter {
+                field: "position/velocity".into(),
+                value: format!("{position:?} / {velocity:?}"),
+                allowed: "finite".into(),
+            });
+        }
+        let r = self.radius[i];
+        for j in 0..n {
+            if j == i || !self.alive[j] {
+                continue;
+            }
+            let gap = (self.position[j] - position).length() - (r + self.radius[j]);
+            if gap < -1e-9 * r.min(self.radius[j]) {
+                return Err(DemfemError::InvalidParameter {
+                    field: "position".into(),
+                    value: format!("{position:?}"),
+                    allowed: format!("a free site (particle {i} would overlap particle {j})"),
+                });
+            }
+        }
+        self.position[i] = position;
+        self.velocity[i] = velocity;
+        self.omega[i] = Vec3::ZERO;
+        self.alive[i] = true;
+        self.needs_rebuild = true;
+        Ok(())
+    }
+
     /// Kinetic energy (translation + rotation) of the alive particles, J.
     pub fn kinetic_energy(&self) -> f64 {
         let mut e = 0.0;
