@@ -19,7 +19,7 @@ import time as _time
 from dataclasses import dataclass
 from typing import Any, Callable, Optional, Sequence
 
-from demfem._core import DemSimulation
+from demfem._core import DemSimulation, RigidSimulation
 
 __all__ = [
     "DemSimulation",
@@ -33,6 +33,7 @@ __all__ = [
     "constant_velocity",
     "run",
     "from_scene",
+    "scene_walls",
     "CONTACT_MODELS",
 ]
 
@@ -120,7 +121,7 @@ class Progress:
 
 
 def run(
-    sim: DemSimulation,
+    sim: "DemSimulation | RigidSimulation",
     t_end: float,
     *,
     progress: Optional[Callable[[Progress], None]] = None,
@@ -217,32 +218,7 @@ def from_scene(
     for n in names:
         wall_index[n] = len(materials)
         materials.append({**materials[names.index(n)], "shell_stiffness": float("inf")})
-    walls = []
-    for w in scene.walls:
-        motion = w.get("motion") or {"kind": "fixed"}
-        kind = motion.get("kind", motion.get("type"))
-        if kind == "fixed":
-            mo = None
-        elif kind == "harmonic":
-            mo = harmonic(tuple(np.asarray(motion["direction"], float)), float(motion["amplitude"]),
-                          float(motion["period"]), float(motion.get("phase", 0.0)))
-        elif kind == "constant":
-            mo = constant_velocity(tuple(np.asarray(motion["velocity"], float)))
-        else:
-            raise InvalidParameterError(f"invalid wall {w.get('name')!r} motion kind = {kind!r}: "
-                                        "must be 'fixed', 'harmonic' or 'constant'")
-        sv = w.get("surface_velocity")
-        sv = None if sv is None or not np.any(np.asarray(sv)) else tuple(np.asarray(sv, float))
-        mat = wall_index[w.get("material", scene.particle_material)]
-        if w["kind"] == "plane":
-            walls.append(plane(tuple(np.asarray(w["point"], float)), tuple(np.asarray(w["normal"], float)),
-                               material=mat, surface_velocity=sv, motion=mo))
-        elif w["kind"] == "polygon":
-            walls.append(polygon([list(map(float, v)) for v in np.asarray(w["vertices"])],
-                                 material=mat, surface_velocity=sv, motion=mo))
-        else:
-            raise InvalidParameterError(f"invalid wall {w.get('name')!r} kind = {w['kind']!r}: "
-                                        "must be 'plane' or 'polygon'")
+    walls = scene_walls(scene, lambda name: wall_index[name])
     removal = scene.removal
     removal_plane = None
     if removal is not None:
@@ -259,3 +235,40 @@ def from_scene(
         threads=threads, record_every=record_every, record_onsets=record_onsets,
         removal_plane=removal_plane,
     )
+
+
+def scene_walls(scene: Any, material_index: Callable[[str], int]) -> list[dict[str, Any]]:
+    """The walls of an engine-neutral scene description as engine wall dicts (the format of
+    :func:`plane` and :func:`polygon`, shared by ``DemSimulation`` and ``RigidSimulation``);
+    ``material_index`` maps a wall's material name to the engine's material index."""
+    import numpy as np
+
+    from demfem.errors import InvalidParameterError
+
+    walls = []
+    for w in scene.walls:
+        motion = w.get("motion") or {"kind": "fixed"}
+        kind = motion.get("kind", motion.get("type"))
+        if kind == "fixed":
+            mo = None
+        elif kind == "harmonic":
+            mo = harmonic(tuple(np.asarray(motion["direction"], float)), float(motion["amplitude"]),
+                          float(motion["period"]), float(motion.get("phase", 0.0)))
+        elif kind == "constant":
+            mo = constant_velocity(tuple(np.asarray(motion["velocity"], float)))
+        else:
+            raise InvalidParameterError(f"invalid wall {w.get('name')!r} motion kind = {kind!r}: "
+                                        "must be 'fixed', 'harmonic' or 'constant'")
+        sv = w.get("surface_velocity")
+        sv = None if sv is None or not np.any(np.asarray(sv)) else tuple(np.asarray(sv, float))
+        mat = material_index(w.get("material", scene.particle_material))
+        if w["kind"] == "plane":
+            walls.append(plane(tuple(np.asarray(w["point"], float)), tuple(np.asarray(w["normal"], float)),
+                               material=mat, surface_velocity=sv, motion=mo))
+        elif w["kind"] == "polygon":
+            walls.append(polygon([list(map(float, v)) for v in np.asarray(w["vertices"])],
+                                 material=mat, surface_velocity=sv, motion=mo))
+        else:
+            raise InvalidParameterError(f"invalid wall {w.get('name')!r} kind = {w['kind']!r}: "
+                                        "must be 'plane' or 'polygon'")
+    return walls
