@@ -126,6 +126,16 @@ def _add_study(sub, name: str, help_text: str) -> argparse.ArgumentParser:
     return s
 
 
+def _cmd_equivalence(args: argparse.Namespace) -> int:
+    from demfem.equivalence import StudyConfig, run_study
+
+    config = StudyConfig(n_spheres=args.n, young_modulus=args.young_modulus, t_end=args.t_end)
+    result = run_study(config, args.out, progress=lambda msg: print("  " + msg, flush=True))
+    print(result["markdown"], end="")
+    print(f"written: {args.out}/equivalence.csv, .md, .png")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``demfem`` command."""
     p = argparse.ArgumentParser(prog="demfem", description="DEM-FEM breakage of glass cartridges "
@@ -163,6 +173,12 @@ def build_parser() -> argparse.ArgumentParser:
                     "and ParaView series")
     f8.add_argument("--snapshots", default="9.3,12.2", metavar="T1,T2,...",
                     help="times of the table snapshots, s (9.3,12.2; clipped to the run)")
+    e = sub.add_parser("equivalence", help="spheres vs clumped vs exact cartridges on one table")
+    e.add_argument("--n", type=int, default=40, help="bodies on the reduced table (40)")
+    e.add_argument("--young-modulus", type=float, default=45e7, help="Young's modulus, Pa (4.5e8)")
+    e.add_argument("--t-end", type=float, default=2.0, help="simulated time, s (2.0)")
+    e.add_argument("--out", default="demfem_out/equivalence", help="output directory")
+    e.set_defaults(func=_cmd_equivalence)
     return p
 
 

@@ -19,7 +19,7 @@ import time as _time
 from dataclasses import dataclass
 from typing import Any, Callable, Optional, Sequence
 
-from demfem._core import DemSimulation
+from demfem._core import DemSimulation, RigidSimulation
 
 __all__ = [
     "DemSimulation",
@@ -34,6 +34,7 @@ __all__ = [
     "run",
     "from_scene",
     "refeed_removed",
+    "scene_walls",
     "CONTACT_MODELS",
 ]
 
@@ -121,7 +122,7 @@ class Progress:
 
 
 def run(
-    sim: DemSimulation,
+    sim: "DemSimulation | RigidSimulation",
     t_end: float,
     *,
     progress: Optional[Callable[[Progress], None]] = None,
@@ -134,7 +135,14 @@ def run(
     ``SimulationInterrupted`` with the state consistent at a step boundary.
 
     ``refeed``: a scene's ``{"sites": (k, 3) m, "velocity": (3,) m/s}``; after every chunk,
-    removed particles are put back at the first free sites (:func:`refeed_removed`)."""
+    removed particles are put back at the first free sites (:func:`refeed_removed`); spheres
+    (``DemSimulation``) only."""
+    if refeed is not None and not isinstance(sim, DemSimulation):
+        from demfem.errors import InvalidParameterError
+
+        raise InvalidParameterError(
+            f"invalid refeed for a {type(sim).__name__}: re-feeding is implemented for "
+            "spheres (DemSimulation) only")
     start_steps = sim.steps
     start_wall = _time.perf_counter()
     last_report = start_wall
@@ -144,7 +152,7 @@ def run(
         k = min(chunk_steps, total - done)
         sim.step(k, chunk=k)
         done += k
-        if refeed is not None:
+        if refeed is not None and isinstance(sim, DemSimulation):
             refeed_removed(sim, refeed["sites"], refeed.get("velocity", (0.0, 0.0, 0.0)))
         now = _time.perf_counter()
         if progress is not None and (now - last_report >= report_every or done == total):
@@ -222,32 +230,7 @@ def from_scene(
     for n in names:
         wall_index[n] = len(materials)
         materials.append({**materials[names.index(n)], "shell_stiffness": float("inf")})
-    walls = []
-    for w in scene.walls:
-        motion = w.get("motion") or {"kind": "fixed"}
-        kind = motion.get("kind", motion.get("type"))
-        if kind == "fixed":
-            mo = None
-        elif kind == "harmonic":
-            mo = harmonic(tuple(np.asarray(motion["direction"], float)), float(motion["amplitude"]),
-                          float(motion["period"]), float(motion.get("phase", 0.0)))
-        elif kind == "constant":
-            mo = constant_velocity(tuple(np.asarray(motion["velocity"], float)))
-        else:
-            raise InvalidParameterError(f"invalid wall {w.get('name')!r} motion kind = {kind!r}: "
-                                        "must be 'fixed', 'harmonic' or 'constant'")
-        sv = w.get("surface_velocity")
-        sv = None if sv is None or not np.any(np.asarray(sv)) else tuple(np.asarray(sv, float))
-        mat = wall_index[w.get("material", scene.particle_material)]
-        if w["kind"] == "plane":
-            walls.append(plane(tuple(np.asarray(w["point"], float)), tuple(np.asarray(w["normal"], float)),
-                               material=mat, surface_velocity=sv, motion=mo))
-        elif w["kind"] == "polygon":
-            walls.append(polygon([list(map(float, v)) for v in np.asarray(w["vertices"])],
-                                 material=mat, surface_velocity=sv, motion=mo))
-        else:
-            raise InvalidParameterError(f"invalid wall {w.get('name')!r} kind = {w['kind']!r}: "
-                                        "must be 'plane' or 'polygon'")
+    walls = scene_walls(scene, lambda name: wall_index[name])
     removal = scene.removal
     removal_plane = None
     if removal is not None:
@@ -296,3 +279,40 @@ def refeed_removed(sim: DemSimulation, sites: Any, velocity: Vector = (0.0, 0.0,
         else:
             break  # every site is taken: the rest wait
     return placed
+
+
+def scene_walls(scene: Any, material_index: Callable[[str], int]) -> list[dict[str, Any]]:
+    """The walls of an engine-neutral scene description as engine wall dicts (the format of
+    :func:`plane` and :func:`polygon`, shared by ``DemSimulation`` and ``RigidSimulation``);
+    ``material_index`` maps a wall's material name to the engine's material index."""
+    import numpy as np
+
+    from demfem.errors import InvalidParameterError
+
+    walls = []
+    for w in scene.walls:
+        motion = w.get("motion") or {"kind": "fixed"}
+        kind = motion.get("kind", motion.get("type"))
+        if kind == "fixed":
+            mo = None
+        elif kind == "harmonic":
+            mo = harmonic(tuple(np.asarray(motion["direction"], float)), float(motion["amplitude"]),
+                          float(motion["period"]), float(motion.get("phase", 0.0)))
+        elif kind == "constant":
+            mo = constant_velocity(tuple(np.asarray(motion["velocity"], float)))
+        else:
+            raise InvalidParameterError(f"invalid wall {w.get('name')!r} motion kind = {kind!r}: "
+                                        "must be 'fixed', 'harmonic' or 'constant'")
+        sv = w.get("surface_velocity")
+        sv = None if sv is None or not np.any(np.asarray(sv)) else tuple(np.asarray(sv, float))
+        mat = material_index(w.get("material", scene.particle_material))
+        if w["kind"] == "plane":
+            walls.append(plane(tuple(np.asarray(w["point"], float)), tuple(np.asarray(w["normal"], float)),
+                               material=mat, surface_velocity=sv, motion=mo))
+        elif w["kind"] == "polygon":
+            walls.append(polygon([list(map(float, v)) for v in np.asarray(w["vertices"])],
+                                 material=mat, surface_velocity=sv, motion=mo))
+        else:
+            raise InvalidParameterError(f"invalid wall {w.get('name')!r} kind = {w['kind']!r}: "
+                                        "must be 'plane' or 'polygon'")
+    return walls

@@ -100,6 +100,9 @@ __all__ = [
     "wall_velocity",
 ]
 
+#: Particle kinds of the table: equivalent spheres, bead clumps, exact cartridge shapes.
+PARTICLES = ("sphere", "clump", "cylinder")
+
 #: Name of this scene in scene files (the optional key ``scene``).
 SCENE_NAME = "accumulation_table"
 
@@ -373,6 +376,13 @@ class AccumulationTable:
             cannot ride on top of its neighbours the way a sphere can.
         refeed: re-insert removed spheres upstream to keep the population steady.
         packing_gap: gap between neighbouring spheres at t = 0, as a fraction of the diameter.
+        particle: what stands at each start site: ``"sphere"`` (the equivalent sphere, run by
+            :func:`demfem.dem.from_scene`), ``"clump"`` (the default cartridge as a rigid clump
+            of beads) or ``"cylinder"`` (the default cartridge as an exact parry shape), both
+            upright on the belt at the sphere's (x, y) and run by
+            :func:`demfem.rigid.from_scene`. Full shapes need ``wall_height`` at least the
+            cartridge length (an upright cartridge must not lean over the walls) and cannot
+            run ``planar``.
     """
 
     n_spheres: int = 840
@@ -398,6 +408,7 @@ class AccumulationTable:
     planar: bool = False
     refeed: bool = False
     packing_gap: float = 0.01
+    particle: str = "sphere"
 
     # ---- validation ------------------------------------------------------------------------
 
@@ -405,7 +416,11 @@ class AccumulationTable:
         # Every float field is normalised to a Python float; a wrong type names its field.
         for f in dataclasses.fields(self):
             value = getattr(self, f.name)
-            if f.type == "bool":
+            if f.type == "str":
+                if not isinstance(value, str):
+                    raise InvalidParameterError(
+                        f"invalid {f.name} = {value!r}: must be a string")
+            elif f.type == "bool":
                 if not _is_bool(value):
                     raise InvalidParameterError(
                         f"invalid {f.name} = {value!r}: must be true or false")
@@ -467,6 +482,24 @@ class AccumulationTable:
         check_range("friction", self.friction, 0.0, inf, lo_open=False)
         check_range("restitution", self.restitution, 0.0, 1.0, hi_open=False)
         check_range("rolling_resistance", self.rolling_resistance, 0.0, inf, lo_open=False)
+        if self.particle not in PARTICLES:
+            raise InvalidParameterError(
+                f"invalid particle = {self.particle!r}: must be one of {PARTICLES}")
+        if self.particle != "sphere":
+            length = Cartridge().length
+            _explained(check_range, "wall_height", self.wall_height, length, inf,
+                       lo_open=False,
+                       why=f"particle = {self.particle!r} stands upright cartridges of "
+                           f"{length:g} m: the walls must be at least that high")
+            if self.planar:
+                raise InvalidParameterError(
+                    f"invalid planar = True with particle = {self.particle!r}: full-shape "
+                    "cartridges move in three dimensions (planar is for spheres)")
+            if self.rolling_resistance > 0:
+                raise InvalidParameterError(
+                    f"invalid rolling_resistance = {self.rolling_resistance!r} with particle = "
+                    f"{self.particle!r}: full shapes roll by their shape, the rolling-"
+                    "resistance model is for spheres; use 0")
         n_min, n_max = self._sphere_count_range()
         if not n_min <= self.n_spheres <= n_max:
             raise InvalidParameterError(
@@ -712,7 +745,36 @@ class AccumulationTable:
             parameters=dataclasses.asdict(self),
         )
         description.check_start_positions()
+        if self.particle != "sphere":
+            self._check_cartridge_clearance(description)
         return description
+
+    def _check_cartridge_clearance(self, description: "SceneDescription") -> None:
+        """Raise if two upright cartridges at the start sites would overlap or one would
+        cross a wall: neighbours' axes must be at least one body diameter apart, and every
+        axis at least one body radius inside every wall (the walls are vertical)."""
+        c = Cartridge()
+        r_body = 0.5 * c.body_outer_diameter
+        xy = description.positions[:, :2]
+        tree = cKDTree(xy)
+        pairs = tree.query_pairs(2.0 * r_body, output_type="ndarray")
+        if len(pairs):
+            i, j = (int(k) for k in pairs[0])
+            raise InvalidParameterError(
+                f"invalid start positions for particle = {self.particle!r}: cartridges {i} "
+                f"and {j} are {float(np.linalg.norm(xy[i] - xy[j])):.4g} m apart, less than "
+                f"the body diameter {2 * r_body:g} m")
+        for w in description.walls:
+            if w["name"] == "belt":
+                continue
+            point = w["point"] if w["kind"] == "plane" else w["vertices"][0]
+            signed = (description.positions - point) @ np.asarray(w["normal"])
+            k = int(np.argmin(signed))
+            if signed[k] < r_body:
+                raise InvalidParameterError(
+                    f"invalid start positions for particle = {self.particle!r}: cartridge {k} "
+                    f"is {signed[k]:.4g} m from wall {w['name']!r}, less than its body radius "
+                    f"{r_body:g} m")
 
     # ---- scene files -----------------------------------------------------------------------
 
@@ -764,7 +826,9 @@ class AccumulationTable:
                  f'scene = "{SCENE_NAME}"']
         for f in dataclasses.fields(self):
             value = getattr(self, f.name)
-            if isinstance(value, bool):
+            if isinstance(value, str):
+                text = json.dumps(value)
+            elif isinstance(value, bool):
                 text = "true" if value else "false"
             elif isinstance(value, int):
                 text = str(value)
@@ -803,6 +867,7 @@ _UNITS: dict[str, str] = {
     "planar": "keep centres in one layer (effect planar)",
     "refeed": "re-insert removed spheres upstream",
     "packing_gap": "gap between start neighbours, fraction of the diameter",
+    "particle": "sphere, clump (632-bead cartridge) or cylinder (exact cartridge)",
 }
 
 

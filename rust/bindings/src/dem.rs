@@ -14,7 +14,7 @@ use demfem::DemfemError;
 
 use crate::{CoreResult, PyDemfemError};
 
-fn shape_err(field: &str, detail: String) -> PyErr {
+pub(crate) fn shape_err(field: &str, detail: String) -> PyErr {
     PyDemfemError::from(DemfemError::ShapeMismatch {
         field: field.into(),
         detail,
@@ -22,7 +22,7 @@ fn shape_err(field: &str, detail: String) -> PyErr {
     .into()
 }
 
-fn invalid(field: &str, value: &str, allowed: &str) -> PyErr {
+pub(crate) fn invalid(field: &str, value: &str, allowed: &str) -> PyErr {
     PyDemfemError::from(DemfemError::InvalidParameter {
         field: field.into(),
         value: value.into(),
@@ -31,7 +31,11 @@ fn invalid(field: &str, value: &str, allowed: &str) -> PyErr {
     .into()
 }
 
-fn vec3s(field: &str, a: &PyReadonlyArray2<'_, f64>, n: Option<usize>) -> PyResult<Vec<Vec3>> {
+pub(crate) fn vec3s(
+    field: &str,
+    a: &PyReadonlyArray2<'_, f64>,
+    n: Option<usize>,
+) -> PyResult<Vec<Vec3>> {
     let v = a.as_array();
     let s = v.shape();
     if s[1] != 3 || n.is_some_and(|n| n != s[0]) {
@@ -50,7 +54,12 @@ fn vec3s(field: &str, a: &PyReadonlyArray2<'_, f64>, n: Option<usize>) -> PyResu
         .collect())
 }
 
-fn get_f64(d: &Bound<'_, PyDict>, key: &str, default: Option<f64>, what: &str) -> PyResult<f64> {
+pub(crate) fn get_f64(
+    d: &Bound<'_, PyDict>,
+    key: &str,
+    default: Option<f64>,
+    what: &str,
+) -> PyResult<f64> {
     match d.get_item(key)? {
         Some(v) => v
             .extract::<f64>()
@@ -90,7 +99,7 @@ fn parse_material(d: &Bound<'_, PyDict>, k: usize) -> PyResult<Material> {
     })
 }
 
-fn parse_wall(d: &Bound<'_, PyDict>, k: usize) -> PyResult<Wall> {
+pub(crate) fn parse_wall(d: &Bound<'_, PyDict>, k: usize) -> PyResult<Wall> {
     let w = format!("walls[{k}]");
     let kind: String = match d.get_item("type")? {
         Some(t) => t.extract()?,
@@ -212,7 +221,7 @@ fn flat3(v: &[Vec3]) -> Vec<f64> {
     out
 }
 
-fn array_n3<'py>(py: Python<'py>, v: &[Vec3]) -> PyResult<Bound<'py, PyAny>> {
+pub(crate) fn array_n3<'py>(py: Python<'py>, v: &[Vec3]) -> PyResult<Bound<'py, PyAny>> {
     Ok(flat3(v).into_pyarray(py).reshape([v.len(), 3])?.into_any())
 }
 

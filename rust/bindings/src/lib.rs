@@ -11,6 +11,7 @@ use demfem::DemfemError;
 
 mod dem;
 mod fem;
+mod rigid;
 
 /// The one conversion from core errors to Python exceptions: each variant raises the class
 /// of the same name from `demfem.errors` (pure Python, so that bad input is both a
@@ -93,12 +94,21 @@ fn normal_force<'py>(
 /// Maximum impact force (N) of two bodies of effective mass m_star (kg) at v_rel (m/s).
 #[pyfunction]
 #[pyo3(signature = (law, m_star, v_rel, k_h=f64::NAN, k_r=f64::NAN, k=f64::NAN))]
-fn max_impact_force(law: &str, m_star: f64, v_rel: f64, k_h: f64, k_r: f64, k: f64) -> PyResult<f64> {
+fn max_impact_force(
+    law: &str,
+    m_star: f64,
+    v_rel: f64,
+    k_h: f64,
+    k_r: f64,
+    k: f64,
+) -> PyResult<f64> {
     contact_checks(m_star, v_rel)?;
     Ok(match parse_law(law, k_h, k_r, k)? {
         NormalLaw::Hertz { k_h } => contact::max_force_hertz(k_h, m_star, v_rel),
         NormalLaw::Linear { k } => contact::max_force_linear(k, m_star, v_rel),
-        NormalLaw::HertzReissner { k_h, k_r } => contact::max_force_hertz_reissner(k_h, k_r, m_star, v_rel),
+        NormalLaw::HertzReissner { k_h, k_r } => {
+            contact::max_force_hertz_reissner(k_h, k_r, m_star, v_rel)
+        }
     })
 }
 
@@ -158,5 +168,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(hertz_contact_duration, m)?)?;
     dem::register(m)?;
     fem::register(m)?;
+    rigid::register(m)?;
     Ok(())
 }

@@ -8,7 +8,9 @@
 //! - [`forces`]: Hertz + Tsuji normal force and Mindlin–Coulomb friction per contact;
 //! - [`scene`]: gravity, belt, walls, time-step limit and the step loop.
 //!
-//! Self-contained: nothing here depends on the sphere DEM in `dem/` or `geometry/`.
+//! Walls other than plain planes (convex polygons, moving walls such as the table's gate)
+//! reuse the wall shapes and motions of [`crate::geometry`]; nothing here depends on the
+//! sphere DEM in `dem/`.
 
 pub mod body;
 pub mod collision;
@@ -17,9 +19,9 @@ pub mod scene;
 pub mod shape;
 
 pub use body::{RigidBodies, RigidBodyInit};
-pub use collision::{BodyPose, ContactPoint, Plane};
+pub use collision::{BodyPose, ContactPoint, Plane, PolygonWall};
 pub use forces::{ContactMaterial, ContactModel};
-pub use scene::{RigidScene, RigidSceneConfig};
+pub use scene::{RigidOnset, RigidScene, RigidSceneConfig, RigidWall};
 pub use shape::{
     BeadClump, BoundingCapsule, ExactShape, MassProperties, RevolutionProfile, RigidShape,
 };

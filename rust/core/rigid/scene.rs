@@ -18,20 +18,22 @@
 //! the pair would be √n times over-damped (a cartridge hitting a wall with its side touches
 //! with ~60 beads at once and would keep a restitution of ~0.15 instead of 0.5).
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::hash::{BuildHasherDefault, Hasher};
 
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 
 use super::body::{RigidBodies, RigidBodyInit};
 use super::collision::{
-    clump_clump_contacts, clump_exact_contacts, clump_plane_contacts, exact_exact_contacts,
-    exact_plane_contacts, BodyPose, ClumpPairScratch, ContactPoint, ExactContactCache, Plane,
+    clump_clump_contacts, clump_exact_contacts, clump_plane_contacts, clump_polygon_contacts,
+    exact_exact_contacts, exact_plane_contacts, exact_polygon_contacts, BodyPose, ClumpPairScratch,
+    ContactPoint, ExactContactCache, Plane, PolygonWall,
 };
 use super::forces::{ContactMaterial, ContactModel};
 use super::shape::{BoundingCapsule, MassProperties, RigidShape};
 use crate::contact::{effective_mass, effective_radius, hertz_contact_duration, hertz_stiffness};
 use crate::error::{check_positive, DemfemError, Result};
+use crate::geometry::{WallMotion, WallShape};
 
 /// Steps per Hertz contact duration at the stable limit. With ~12 beads in contact at once
 /// (a ring on the belt) the stiffness grows twelvefold and ω Δt ≈ 0.36, still far from the
@@ -39,7 +41,7 @@ use crate::error::{check_positive, DemfemError, Result};
 pub const STEPS_PER_CONTACT: f64 = 30.0;
 
 /// Parameters of a rigid scene, SI.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub struct RigidSceneConfig {
     /// Gravity, m/s².
     pub gravity: Vector3<f64>,
@@ -57,6 +59,100 @@ pub struct RigidSceneConfig {
     pub max_expected_speed: f64,
     /// Time step, s; `None` takes the stable limit.
     pub time_step: Option<f64>,
+    /// Walls beyond `planes`: planes or convex polygons with a prescribed motion (the gate).
+    /// Their contacts are numbered after `planes` (wall `w` is boundary `planes.len() + w`).
+    pub walls: Vec<RigidWall>,
+    /// Outlet: a body whose centre of mass x has (x − point) · normal < 0 is removed (it
+    /// stops moving and touching anything); `normal` (any length > 0) points to the kept
+    /// side, as `DemSimulation`'s `removal_plane`. Points in m.
+    pub removal_plane: Option<(Vector3<f64>, Vector3<f64>)>,
+    /// Log the first step of every new contact ([`RigidOnset`]).
+    pub record_onsets: bool,
+}
+
+/// A wall of a rigid scene: a plane or a convex polygon of [`crate::geometry`], translated
+/// rigidly by `motion` (fixed, constant velocity, harmonic: the gate), whose surface moves
+/// with `surface_velocity` (m/s) on top of that (a belt).
+#[derive(Debug, Clone)]
+pub struct RigidWall {
+    /// Geometry at its reference position, m.
+    pub shape: WallShape,
+    /// Prescribed translation.
+    pub motion: WallMotion,
+    /// Velocity of the surface material while the geometry stays put, m/s.
+    pub surface_velocity: Vector3<f64>,
+}
+
+/// The first force evaluation of a new contact between a body and another body or a
+/// boundary (a pair counts as one contact however many beads or points touch).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RigidOnset {
+    /// Simulated time, s.
+    pub time: f64,
+    /// The body (the lower index for body pairs).
+    pub body: u32,
+    /// The other body, or the boundary index (planes first, then walls).
+    pub partner: u32,
+    /// True when `partner` is a plane or wall.
+    pub partner_is_wall: bool,
+    /// Normal approach speed at the deepest contact point, m/s (> 0 approaching).
+    pub normal_speed: f64,
+    /// Tangential relative speed at that point, m/s.
+    pub tangential_speed: f64,
+}
+
+/// A wall prepared for the contact pass.
+#[derive(Debug, Clone)]
+enum PreparedShape {
+    Plane {
+        point: Vector3<f64>,
+        normal: Vector3<f64>,
+    },
+    Polygon(PolygonWall),
+}
+
+#[derive(Debug, Clone)]
+struct PreparedWall {
+    shape: PreparedShape,
+    motion: WallMotion,
+    surface_velocity: Vector3<f64>,
+}
+
+fn prepare_wall(k: usize, wall: &RigidWall) -> Result<PreparedWall> {
+    if !wall.surface_velocity.iter().all(|v| v.is_finite()) {
+        return Err(DemfemError::invalid(
+            &format!("walls[{k}].surface_velocity"),
+            f64::NAN,
+            "finite components",
+        ));
+    }
+    if let WallMotion::ConstantVelocity { velocity } = wall.motion {
+        if !velocity.is_finite() {
+            return Err(DemfemError::invalid(
+                &format!("walls[{k}].motion.velocity"),
+                f64::NAN,
+                "finite components",
+            ));
+        }
+    }
+    let shape = match &wall.shape {
+        WallShape::Plane { point, normal } => PreparedShape::Plane {
+            point: Vector3::new(point.x, point.y, point.z),
+            normal: Vector3::new(normal.x, normal.y, normal.z),
+        },
+        polygon @ WallShape::Polygon { .. } => PreparedShape::Polygon(PolygonWall::new(polygon)?),
+        WallShape::Cuboid { .. } => {
+            return Err(DemfemError::ShapeMismatch {
+                field: format!("walls[{k}]"),
+                detail: "rigid scenes take plane and polygon walls, not cuboids".into(),
+            })
+        }
+    };
+    Ok(PreparedWall {
+        shape,
+        motion: wall.motion,
+        surface_velocity: wall.surface_velocity,
+    })
 }
 
 impl Default for RigidSceneConfig {
@@ -70,6 +166,9 @@ impl Default for RigidSceneConfig {
             friction: 0.2,
             max_expected_speed: 5.0,
             time_step: None,
+            walls: Vec::new(),
+            removal_plane: None,
+            record_onsets: false,
         }
     }
 }
@@ -136,6 +235,16 @@ pub struct RigidScene {
     friction_history_next: FrictionHistory,
     contacts_last_step: usize,
     max_overlap_last_step: f64,
+    walls: Vec<PreparedWall>,
+    removal_plane: Option<(Vector3<f64>, Vector3<f64>)>,
+    alive: Vec<bool>,
+    removals: Vec<(f64, u32)>,
+    record_onsets: bool,
+    onsets: Vec<RigidOnset>,
+    touching: HashSet<u64>,
+    touching_next: HashSet<u64>,
+    coordination: Vec<u32>,
+    wall_contacts: Vec<u32>,
 }
 
 impl RigidScene {
@@ -151,6 +260,25 @@ impl RigidScene {
         if let Some(dt) = config.time_step {
             check_positive("time_step", dt)?;
         }
+        let walls = config
+            .walls
+            .iter()
+            .enumerate()
+            .map(|(k, w)| prepare_wall(k, w))
+            .collect::<Result<Vec<_>>>()?;
+        let removal_plane = match config.removal_plane {
+            None => None,
+            Some((point, normal)) => {
+                let length = normal.norm();
+                if !(length > 0.0 && length.is_finite() && point.iter().all(|v| v.is_finite())) {
+                    return Err(DemfemError::ShapeMismatch {
+                        field: "removal_plane".into(),
+                        detail: "point finite, normal finite and non-zero".into(),
+                    });
+                }
+                Some((point, normal / length))
+            }
+        };
         let model = ContactModel::new(
             config.body_material,
             config.plane_material,
@@ -179,6 +307,16 @@ impl RigidScene {
             friction_history_next: FrictionHistory::default(),
             contacts_last_step: 0,
             max_overlap_last_step: 0.0,
+            walls,
+            removal_plane,
+            alive: Vec::new(),
+            removals: Vec::new(),
+            record_onsets: config.record_onsets,
+            onsets: Vec::new(),
+            touching: HashSet::new(),
+            touching_next: HashSet::new(),
+            coordination: Vec::new(),
+            wall_contacts: Vec::new(),
         })
     }
 
@@ -219,6 +357,9 @@ impl RigidScene {
             principal_inertia: mass.principal_inertia,
         })?;
         self.body_shape.push(shape_id);
+        self.alive.push(true);
+        self.coordination.push(0);
+        self.wall_contacts.push(0);
         self.forces_current = false;
         self.update_time_step()?;
         Ok(index)
@@ -300,6 +441,36 @@ impl RigidScene {
         self.max_overlap_last_step
     }
 
+    /// Whether each body is still in the scene (not removed through the outlet).
+    pub fn alive(&self) -> &[bool] {
+        &self.alive
+    }
+
+    /// Bodies removed through the outlet: (time (s), body index).
+    pub fn removals(&self) -> &[(f64, u32)] {
+        &self.removals
+    }
+
+    /// Contact onsets logged so far (with `record_onsets`).
+    pub fn onsets(&self) -> &[RigidOnset] {
+        &self.onsets
+    }
+
+    /// Drop the logged onsets.
+    pub fn clear_onsets(&mut self) {
+        self.onsets.clear();
+    }
+
+    /// Bodies each body touched in the last force evaluation (coordination number).
+    pub fn coordination(&self) -> &[u32] {
+        &self.coordination
+    }
+
+    /// Planes and walls each body touched in the last force evaluation.
+    pub fn wall_contacts(&self) -> &[u32] {
+        &self.wall_contacts
+    }
+
     /// Shape of body `i`.
     pub fn shape_of(&self, i: usize) -> Option<&RigidShape> {
         self.body_shape.get(i).map(|&s| &self.shapes[s].0)
@@ -312,15 +483,18 @@ impl RigidScene {
         }
         let h = self.time_step;
         if !self.forces_current {
-            self.compute_forces()?;
+            self.compute_forces(self.time)?;
         }
         for _ in 0..n_steps {
             self.bodies.kick(0.5 * h);
             self.bodies.drift(h);
-            self.compute_forces()?;
+            self.compute_forces(self.time + h)?;
             self.bodies.kick(0.5 * h);
             self.time += h;
             self.steps += 1;
+            if self.removal_plane.is_some() {
+                self.remove_past_outlet();
+            }
         }
         for i in 0..self.bodies.len() {
             let finite = self.bodies.position[i].iter().all(|v| v.is_finite())
@@ -345,8 +519,70 @@ impl RigidScene {
         }
     }
 
-    /// Gravity and every contact force and torque of the current configuration.
-    fn compute_forces(&mut self) -> Result<()> {
+    /// Remove the bodies whose centre of mass has crossed the removal plane.
+    fn remove_past_outlet(&mut self) {
+        let Some((point, normal)) = self.removal_plane else {
+            return;
+        };
+        for i in 0..self.bodies.len() {
+            if self.alive[i] && (self.bodies.position[i] - point).dot(&normal) < 0.0 {
+                self.remove_body(i);
+            }
+        }
+    }
+
+    /// Take body `i` out of the scene: it stops, feels no force and touches nothing.
+    pub fn remove_body(&mut self, i: usize) {
+        if i < self.alive.len() && self.alive[i] {
+            self.alive[i] = false;
+            self.bodies.velocity[i] = Vector3::zeros();
+            self.bodies.angular_velocity_body[i] = Vector3::zeros();
+            self.bodies.force[i] = Vector3::zeros();
+            self.bodies.torque[i] = Vector3::zeros();
+            self.removals.push((self.time, i as u32));
+        }
+    }
+
+    /// Note that bodies (or a body and a boundary) touch under `key`; log an onset when they
+    /// did not touch at the previous evaluation. `relative` is the velocity of the second
+    /// surface minus the first at the deepest point, whose normal is `normal`.
+    fn note_touch(
+        &mut self,
+        key: u64,
+        body: usize,
+        partner: usize,
+        partner_is_wall: bool,
+        time: f64,
+        relative: &Vector3<f64>,
+        normal: &Vector3<f64>,
+    ) {
+        self.touching_next.insert(key);
+        if partner_is_wall {
+            self.wall_contacts[body] += 1;
+        } else {
+            self.coordination[body] += 1;
+            self.coordination[partner] += 1;
+        }
+        if self.record_onsets && !self.touching.contains(&key) {
+            let v_n = relative.dot(normal);
+            let (first, second) = if partner_is_wall {
+                (body, partner)
+            } else {
+                (body.min(partner), body.max(partner))
+            };
+            self.onsets.push(RigidOnset {
+                time,
+                body: first as u32,
+                partner: second as u32,
+                partner_is_wall,
+                normal_speed: -v_n,
+                tangential_speed: (relative - normal * v_n).norm(),
+            });
+        }
+    }
+
+    /// Gravity and every contact force and torque of the configuration at time `time` (s).
+    fn compute_forces(&mut self, time: f64) -> Result<()> {
         self.bodies.clear_forces();
         self.evaluations += 1;
         let evaluation = self.evaluations;
@@ -357,32 +593,122 @@ impl RigidScene {
         let mut current = std::mem::take(&mut self.friction_history_next);
         current.clear();
         for i in 0..self.bodies.len() {
-            self.bodies.force[i] = self.gravity * self.bodies.mass[i];
+            self.bodies.force[i] = if self.alive[i] {
+                self.gravity * self.bodies.mass[i]
+            } else {
+                Vector3::zeros()
+            };
         }
+        std::mem::swap(&mut self.touching, &mut self.touching_next);
+        self.touching_next.clear();
+        self.coordination.iter_mut().for_each(|c| *c = 0);
+        self.wall_contacts.iter_mut().for_each(|c| *c = 0);
         let mut contacts = std::mem::take(&mut self.contacts);
         let mut count = 0;
         let mut max_overlap: f64 = 0.0;
         let n_planes = self.planes.len();
+        let n_boundaries = n_planes + self.walls.len();
+        // boundaries at this time: planes as given, walls displaced by their motion
+        let offsets: Vec<(Vector3<f64>, Vector3<f64>)> = self
+            .walls
+            .iter()
+            .map(|w| {
+                let (x, v) = w.motion.offset_and_velocity(time);
+                (Vector3::new(x.x, x.y, x.z), Vector3::new(v.x, v.y, v.z))
+            })
+            .collect();
         for i in 0..self.bodies.len() {
+            if !self.alive[i] {
+                continue;
+            }
             let pose = self.pose(i);
-            for p in 0..n_planes {
+            for p in 0..n_boundaries {
                 contacts.clear();
-                let plane = self.planes[p];
-                match &self.shapes[self.body_shape[i]].0 {
-                    RigidShape::Clump(clump) => {
-                        clump_plane_contacts(&plane, clump, &pose, &mut contacts)
+                let shape_i = &self.shapes[self.body_shape[i]].0;
+                let surface_velocity = if p < n_planes {
+                    let plane = self.planes[p];
+                    match shape_i {
+                        RigidShape::Clump(clump) => {
+                            clump_plane_contacts(&plane, clump, &pose, &mut contacts)
+                        }
+                        RigidShape::Exact(shape) => {
+                            let cache = self.exact_caches.entry((i, usize::MAX - p)).or_default();
+                            cache.last_used = evaluation;
+                            exact_plane_contacts(&plane, shape, &pose, cache, &mut contacts)?
+                        }
                     }
-                    RigidShape::Exact(shape) => {
-                        let cache = self.exact_caches.entry((i, usize::MAX - p)).or_default();
-                        cache.last_used = evaluation;
-                        exact_plane_contacts(&plane, shape, &pose, cache, &mut contacts)?
+                    plane.surface_velocity
+                } else {
+                    let wall = &self.walls[p - n_planes];
+                    let (offset, velocity) = offsets[p - n_planes];
+                    match (&wall.shape, shape_i) {
+                        (PreparedShape::Plane { point, normal }, _) => {
+                            let plane = Plane {
+                                point: point + offset,
+                                normal: *normal,
+                                surface_velocity: Vector3::zeros(),
+                            };
+                            match shape_i {
+                                RigidShape::Clump(clump) => {
+                                    clump_plane_contacts(&plane, clump, &pose, &mut contacts)
+                                }
+                                RigidShape::Exact(shape) => {
+                                    let cache =
+                                        self.exact_caches.entry((i, usize::MAX - p)).or_default();
+                                    cache.last_used = evaluation;
+                                    exact_plane_contacts(
+                                        &plane,
+                                        shape,
+                                        &pose,
+                                        cache,
+                                        &mut contacts,
+                                    )?
+                                }
+                            }
+                        }
+                        (PreparedShape::Polygon(polygon), RigidShape::Clump(clump)) => {
+                            clump_polygon_contacts(polygon, &offset, clump, &pose, &mut contacts)
+                        }
+                        (PreparedShape::Polygon(polygon), RigidShape::Exact(shape)) => {
+                            let cache = self.exact_caches.entry((i, usize::MAX - p)).or_default();
+                            cache.last_used = evaluation;
+                            exact_polygon_contacts(
+                                polygon,
+                                &offset,
+                                shape,
+                                &pose,
+                                cache,
+                                &mut contacts,
+                            )?
+                        }
                     }
+                    wall.surface_velocity + velocity
+                };
+                if contacts.is_empty() {
+                    continue;
                 }
                 count += contacts.len();
-                let m_star = self.bodies.mass[i] / contacts.len().max(1) as f64;
+                let m_star = self.bodies.mass[i] / contacts.len() as f64;
+                let mut deepest = 0;
+                for (k, c) in contacts.iter().enumerate() {
+                    if c.overlap > contacts[deepest].overlap {
+                        deepest = k;
+                    }
+                }
+                let c0 = contacts[deepest];
+                let relative0 = self.bodies.point_velocity(i, &c0.point) - surface_velocity;
+                self.note_touch(
+                    plane_object(p) << 32 | i as u64,
+                    i,
+                    p,
+                    true,
+                    time,
+                    &relative0,
+                    &c0.normal,
+                );
                 for c in &contacts {
                     max_overlap = max_overlap.max(c.overlap);
-                    let relative = self.bodies.point_velocity(i, &c.point) - plane.surface_velocity;
+                    let relative = self.bodies.point_velocity(i, &c.point) - surface_velocity;
                     let key = (
                         plane_object(p) << 32 | i as u64,
                         c.feature_first,
@@ -412,6 +738,9 @@ impl RigidScene {
         let mut order = std::mem::take(&mut self.sweep_order);
         order.clear();
         for i in 0..self.bodies.len() {
+            if !self.alive[i] {
+                continue;
+            }
             let r = self.shapes[self.body_shape[i]].0.bounding_radius();
             order.push((
                 self.bodies.position[i].x - r,
@@ -470,9 +799,30 @@ impl RigidScene {
                         clump_exact_contacts(cb, &pb, ea, &pa, &mut contacts)?
                     }
                 }
+                if contacts.is_empty() {
+                    continue;
+                }
                 let (first, second) = if flipped { (b, a) } else { (a, b) };
                 let m_star = effective_mass(self.bodies.mass[first], self.bodies.mass[second])?
-                    / contacts.len().max(1) as f64;
+                    / contacts.len() as f64;
+                let mut deepest = 0;
+                for (k, c) in contacts.iter().enumerate() {
+                    if c.overlap > contacts[deepest].overlap {
+                        deepest = k;
+                    }
+                }
+                let c0 = contacts[deepest];
+                let relative0 = self.bodies.point_velocity(second, &c0.point)
+                    - self.bodies.point_velocity(first, &c0.point);
+                self.note_touch(
+                    (a as u64) << 32 | b as u64,
+                    a,
+                    b,
+                    false,
+                    time,
+                    &relative0,
+                    &c0.normal,
+                );
                 count += contacts.len();
                 for c in &contacts {
                     max_overlap = max_overlap.max(c.overlap);
