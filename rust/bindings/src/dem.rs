@@ -417,29 +417,21 @@ impl DemSimulation {
     /// raises SimulationInterrupted with the state consistent at a step boundary.
     #[pyo3(signature = (n, chunk=2000))]
     fn step(&mut self, py: Python<'_>, n: u64, chunk: u64) -> PyResult<()> {
-        let chunk = chunk.max(1);
-        let mut done = 0;
-        while done < n {
-            let k = chunk.min(n - done);
-            let sim = &mut self.sim;
-            py.detach(|| sim.step(k)).map_err(PyDemfemError::from)?;
-            done += k;
-            self.interrupt_check(py)?;
-        }
-        Ok(())
+        crate::run_in_chunks(
+            py,
+            &mut self.sim,
+            n,
+            chunk,
+            |sim, k| sim.step(k),
+            |sim| (sim.time(), sim.steps()),
+            |_| Ok(()),
+        )
     }
 
     /// Advance until the simulated time reaches `t_end` (s); returns the steps taken.
     #[pyo3(signature = (t_end, chunk=2000))]
     fn run_until(&mut self, py: Python<'_>, t_end: f64, chunk: u64) -> PyResult<u64> {
-        if !t_end.is_finite() {
-            return Err(invalid("t_end", &t_end.to_string(), "finite"));
-        }
-        let remaining = ((t_end - self.sim.time()) / self.sim.dt()).ceil();
-        if remaining <= 0.0 {
-            return Ok(0);
-        }
-        let n = remaining as u64;
+        let n = crate::steps_until(t_end, self.sim.time(), self.sim.dt())?;
         self.step(py, n, chunk)?;
         Ok(n)
     }
@@ -744,19 +736,6 @@ impl DemSimulation {
 }
 
 impl DemSimulation {
-    fn interrupt_check(&self, py: Python<'_>) -> PyResult<()> {
-        if let Err(e) = py.check_signals() {
-            if e.is_instance_of::<pyo3::exceptions::PyKeyboardInterrupt>(py) {
-                return Err(PyDemfemError::from(DemfemError::Interrupted {
-                    time: self.sim.time(),
-                    steps: self.sim.steps(),
-                })
-                .into());
-            }
-            return Err(e);
-        }
-        Ok(())
-    }
 }
 
 /// Register the DEM classes on the extension module.

@@ -288,21 +288,20 @@ impl FemTetSolver {
     /// SimulationInterrupted (the state stays consistent at a step boundary).
     #[pyo3(signature = (n_steps, chunk=1000, progress=None))]
     fn run(&mut self, py: Python<'_>, n_steps: u64, chunk: u64, progress: Option<Bound<'_, PyAny>>) -> PyResult<()> {
-        let chunk = chunk.max(1);
-        let mut done = 0;
-        while done < n_steps {
-            let k = chunk.min(n_steps - done);
-            let inner = &mut self.inner;
-            py.detach(|| inner.run(k)).map_err(PyDemfemError::from)?;
-            done += k;
-            if let Some(cb) = &progress {
-                cb.call1((self.inner.steps(), self.inner.time()))?;
-            }
-            if py.check_signals().is_err() {
-                return Err(PyDemfemError::from(DemfemError::Interrupted { time: self.inner.time(), steps: self.inner.steps() }).into());
-            }
-        }
-        Ok(())
+        crate::run_in_chunks(
+            py,
+            &mut self.inner,
+            n_steps,
+            chunk,
+            |inner, k| inner.run(k),
+            |inner| (inner.time(), inner.steps()),
+            |inner| {
+                if let Some(cb) = &progress {
+                    cb.call1((inner.steps(), inner.time()))?;
+                }
+                Ok(())
+            },
+        )
     }
 
     /// Time step in use, s.

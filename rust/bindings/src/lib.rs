@@ -49,6 +49,52 @@ impl From<PyDemfemError> for PyErr {
     }
 }
 
+/// Advance a simulation `n` steps in chunks of `chunk`, with the GIL released while each
+/// chunk runs. Between chunks `after_chunk` runs with the GIL held (progress callbacks), then
+/// Ctrl-C is checked: it raises `SimulationInterrupted` with the time and step count of the
+/// consistent state reached (`clock`). The one stepping loop of every simulation class.
+pub(crate) fn run_in_chunks<S: Send>(
+    py: Python<'_>,
+    state: &mut S,
+    n: u64,
+    chunk: u64,
+    advance: impl Fn(&mut S, u64) -> demfem::Result<()> + Sync,
+    clock: impl Fn(&S) -> (f64, u64),
+    mut after_chunk: impl FnMut(&S) -> PyResult<()>,
+) -> PyResult<()> {
+    let chunk = chunk.max(1);
+    let mut done = 0;
+    while done < n {
+        let k = chunk.min(n - done);
+        py.detach(|| advance(&mut *state, k)).map_err(PyDemfemError::from)?;
+        done += k;
+        after_chunk(state)?;
+        if let Err(e) = py.check_signals() {
+            if e.is_instance_of::<pyo3::exceptions::PyKeyboardInterrupt>(py) {
+                let (time, steps) = clock(state);
+                return Err(PyDemfemError::from(DemfemError::Interrupted { time, steps }).into());
+            }
+            return Err(e);
+        }
+    }
+    Ok(())
+}
+
+/// Whole steps of `dt` (s) from `time` to reach `t_end` (s), at least 0; `t_end` must be
+/// finite.
+pub(crate) fn steps_until(t_end: f64, time: f64, dt: f64) -> PyResult<u64> {
+    if !t_end.is_finite() {
+        return Err(PyDemfemError::from(DemfemError::InvalidParameter {
+            field: "t_end".into(),
+            value: t_end.to_string(),
+            allowed: "finite".into(),
+        })
+        .into());
+    }
+    let remaining = ((t_end - time) / dt).ceil();
+    Ok(if remaining > 0.0 { remaining as u64 } else { 0 })
+}
+
 pub(crate) type CoreResult<T> = Result<T, PyDemfemError>;
 
 fn parse_law(law: &str, k_h: f64, k_r: f64, k: f64) -> CoreResult<NormalLaw> {

@@ -8,7 +8,7 @@
 //! frame. Angular velocities are in the world frame (rad/s).
 
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
-use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
+use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
@@ -254,38 +254,21 @@ impl RigidSimulation {
     /// raises SimulationInterrupted with the state consistent at a step boundary.
     #[pyo3(signature = (n, chunk=2000))]
     fn step(&mut self, py: Python<'_>, n: u64, chunk: u64) -> PyResult<()> {
-        let chunk = chunk.max(1);
-        let mut done = 0;
-        while done < n {
-            let k = chunk.min(n - done);
-            let scene = &mut self.scene;
-            py.detach(|| scene.run(k)).map_err(PyDemfemError::from)?;
-            done += k;
-            if let Err(e) = py.check_signals() {
-                if e.is_instance_of::<pyo3::exceptions::PyKeyboardInterrupt>(py) {
-                    return Err(PyDemfemError::from(DemfemError::Interrupted {
-                        time: self.scene.time(),
-                        steps: self.scene.steps(),
-                    })
-                    .into());
-                }
-                return Err(e);
-            }
-        }
-        Ok(())
+        crate::run_in_chunks(
+            py,
+            &mut self.scene,
+            n,
+            chunk,
+            |scene, k| scene.run(k),
+            |scene| (scene.time(), scene.steps()),
+            |_| Ok(()),
+        )
     }
 
     /// Advance until the simulated time reaches `t_end` (s); returns the steps taken.
     #[pyo3(signature = (t_end, chunk=2000))]
     fn run_until(&mut self, py: Python<'_>, t_end: f64, chunk: u64) -> PyResult<u64> {
-        if !t_end.is_finite() {
-            return Err(invalid("t_end", &t_end.to_string(), "finite"));
-        }
-        let remaining = ((t_end - self.scene.time()) / self.scene.time_step()).ceil();
-        if remaining <= 0.0 {
-            return Ok(0);
-        }
-        let n = remaining as u64;
+        let n = crate::steps_until(t_end, self.scene.time(), self.scene.time_step())?;
         self.step(py, n, chunk)?;
         Ok(n)
     }
