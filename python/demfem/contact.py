@@ -350,6 +350,15 @@ def _tsuji_rhs(zeta: float, clamp: bool):
     return rhs
 
 
+def _overlap_exit(_t: float, y: np.ndarray) -> float:
+    """solve_ivp event: the overlap y[0] returns to zero (the bodies separate)."""
+    return y[0]
+
+
+_overlap_exit.terminal = True  # type: ignore[attr-defined]
+_overlap_exit.direction = -1  # type: ignore[attr-defined]
+
+
 def tsuji_restitution(zeta: float, clamp: bool = False) -> float:
     """Restitution coefficient of a Hertz impact with Tsuji damping (dimensionless).
 
@@ -364,12 +373,7 @@ def tsuji_restitution(zeta: float, clamp: bool = False) -> float:
     zeta = check_range("zeta", zeta, 0.0, math.inf, lo_open=False)
     rhs = _tsuji_rhs(zeta, clamp)
 
-    def exit_overlap(_t: float, y: np.ndarray) -> float:
-        return y[0]
-
-    exit_overlap.terminal = True  # type: ignore[attr-defined]
-    exit_overlap.direction = -1  # type: ignore[attr-defined]
-    events = [exit_overlap]
+    events = [_overlap_exit]
     if clamp:
         def zero_force(_t: float, y: np.ndarray) -> float:
             x = max(y[0], 0.0)
@@ -430,12 +434,7 @@ def damped_hertz_impact(a: ContactBody, b: ContactBody, v_rel: float, restitutio
     def rhs(_t: float, y: np.ndarray) -> list[float]:
         return [y[1], -force(y[0], y[1]) / m_star]
 
-    def leave(_t: float, y: np.ndarray) -> float:
-        return y[0]
-
-    leave.terminal = True  # type: ignore[attr-defined]
-    leave.direction = -1  # type: ignore[attr-defined]
-    events = [leave]
+    events = [_overlap_exit]
     if clamp:
         def unload(_t: float, y: np.ndarray) -> float:
             return force(y[0], y[1]) if y[1] < 0 else 1.0

@@ -616,15 +616,7 @@ impl DemSimulation {
                 .collect::<Vec<_>>()
                 .into_pyarray(py),
         )?;
-        let (partner, is_wall): (Vec<u32>, Vec<bool>) = o
-            .iter()
-            .map(|x| match x.partner {
-                Partner::Particle(j) => (j, false),
-                Partner::Wall(w) => (w, true),
-            })
-            .unzip();
-        d.set_item("partner", partner.into_pyarray(py))?;
-        d.set_item("partner_is_wall", is_wall.into_pyarray(py))?;
+        set_partner_columns(py, &d, o.iter().map(|x| x.partner))?;
         d.set_item(
             "normal_speed",
             o.iter()
@@ -665,15 +657,7 @@ impl DemSimulation {
                 .collect::<Vec<_>>()
                 .into_pyarray(py),
         )?;
-        let (partner, is_wall): (Vec<u32>, Vec<bool>) = c
-            .iter()
-            .map(|x| match x.partner {
-                Partner::Particle(j) => (j, false),
-                Partner::Wall(w) => (w, true),
-            })
-            .unzip();
-        d.set_item("partner", partner.into_pyarray(py))?;
-        d.set_item("partner_is_wall", is_wall.into_pyarray(py))?;
+        set_partner_columns(py, &d, c.iter().map(|x| x.partner))?;
         d.set_item(
             "normal",
             array_n3(py, &c.iter().map(|x| x.normal).collect::<Vec<_>>())?,
@@ -736,6 +720,23 @@ impl DemSimulation {
 }
 
 impl DemSimulation {
+}
+
+/// The `partner` (index) and `partner_is_wall` columns of an onset or contact table.
+fn set_partner_columns(
+    py: Python<'_>,
+    d: &Bound<'_, PyDict>,
+    partners: impl Iterator<Item = Partner>,
+) -> PyResult<()> {
+    let (partner, is_wall): (Vec<u32>, Vec<bool>) = partners
+        .map(|p| match p {
+            Partner::Particle(j) => (j, false),
+            Partner::Wall(w) => (w, true),
+        })
+        .unzip();
+    d.set_item("partner", partner.into_pyarray(py))?;
+    d.set_item("partner_is_wall", is_wall.into_pyarray(py))?;
+    Ok(())
 }
 
 /// Register the DEM classes on the extension module.

@@ -184,6 +184,31 @@ impl RigidSceneConfig {
 /// first, feature on the second); planes are objects `u32::MAX − plane index`.
 type ContactKey = (u64, u64, u64);
 
+/// Force of one contact point, carrying its Mindlin spring over from the previous step when
+/// `history` is given: the spring of `key` is read from the first map (zero for a new
+/// contact) and the updated one stored in the second. N.
+#[allow(clippy::too_many_arguments)]
+fn force_with_history(
+    model: &ContactModel,
+    contact: &ContactPoint,
+    relative_velocity: &Vector3<f64>,
+    effective_mass: f64,
+    e_star: f64,
+    key: ContactKey,
+    history: Option<(&FrictionHistory, &mut FrictionHistory)>,
+    dt: f64,
+) -> Result<Vector3<f64>> {
+    let mut xi = history
+        .as_ref()
+        .and_then(|(previous, _)| previous.get(&key).copied())
+        .unwrap_or_else(Vector3::zeros);
+    let f = model.force(contact, relative_velocity, effective_mass, e_star, &mut xi, dt)?;
+    if let Some((_, current)) = history {
+        current.insert(key, xi);
+    }
+    Ok(f)
+}
+
 /// Multiply–rotate hash for small integer keys (the FxHash scheme): the default SipHash
 /// would cost more than the force it looks up.
 #[derive(Default, Clone, Copy)]
@@ -714,22 +739,16 @@ impl RigidScene {
                         c.feature_first,
                         c.feature_second,
                     );
-                    let mut xi = if with_history {
-                        previous.get(&key).copied().unwrap_or_else(Vector3::zeros)
-                    } else {
-                        Vector3::zeros()
-                    };
-                    let f = self.model.force(
+                    let f = force_with_history(
+                        &self.model,
                         c,
                         &relative,
                         m_star,
                         self.model.e_star_body_plane,
-                        &mut xi,
+                        key,
+                        with_history.then_some((&previous, &mut current)),
                         dt,
                     )?;
-                    if with_history {
-                        current.insert(key, xi);
-                    }
                     self.apply(i, &c.point, &f);
                 }
             }
@@ -833,22 +852,16 @@ impl RigidScene {
                         c.feature_first,
                         c.feature_second,
                     );
-                    let mut xi = if with_history {
-                        previous.get(&key).copied().unwrap_or_else(Vector3::zeros)
-                    } else {
-                        Vector3::zeros()
-                    };
-                    let f = self.model.force(
+                    let f = force_with_history(
+                        &self.model,
                         c,
                         &relative,
                         m_star,
                         self.model.e_star_body_body,
-                        &mut xi,
+                        key,
+                        with_history.then_some((&previous, &mut current)),
                         dt,
                     )?;
-                    if with_history {
-                        current.insert(key, xi);
-                    }
                     self.apply(second, &c.point, &f);
                     self.apply(first, &c.point, &(-f));
                 }
