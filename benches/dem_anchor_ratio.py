@@ -8,6 +8,7 @@ prints particle-steps per second and demfem's ratio to each. Because the codes r
 session, the ratio is robust to the load of a shared machine; the absolute numbers are not.
 
     python benches/dem_anchor_ratio.py --steps 20000 --settle 2000 [--threads 1 2] [--skip-yade]
+    python benches/dem_anchor_ratio.py --state packed --steps 20000 --reps 3   # after bench_all.py prepare
 
 Needs the Debian packages yade and liggghts for the anchors, and demfem built
 (``maturin develop --release``).
@@ -17,6 +18,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -33,11 +35,38 @@ def run_anchor(cmd: list[str], cwd: str) -> dict:
     raise RuntimeError(f"{cmd[0]} gave no RESULT line:\n{out.stdout[-2000:]}\n{out.stderr[-2000:]}")
 
 
-def run_demfem(e: float, steps: int, settle: int, threads: int, start: str) -> dict:
+def prep_steps(e: float, anchors: str) -> int:
+    """Steps the anchors take to make their packed state (1.511 s simulated; bench_all.py)."""
+    sys.path.insert(0, anchors)
+    import bench_all  # noqa: E402  (the anchors' own definition, so all codes agree)
+
+    return int(bench_all.prep_steps(e))
+
+
+def demfem_packed_state(e: float, anchors: str, cache: str) -> str:
+    """demfem's packed state made exactly as the anchors make theirs (bench_all.py prepare):
+    the square start with every sphere moving at the belt speed, run for 1.511 s; cached."""
     from demfem.dem import DemSimulation
 
-    sim = DemSimulation.anchor_table(e, start=start, threads=threads, initial_vx=0.2 if start == "packed" else 0.0)
-    sim.step(settle)
+    path = os.path.join(cache, f"demfem_funnel_E{e:g}.ck")
+    if not os.path.exists(path):
+        n = prep_steps(e, anchors)
+        print(f"preparing demfem's packed state: {n} steps (cached in {path})", flush=True)
+        sim = DemSimulation.anchor_table(e, start="square", threads=2, initial_vx=0.2)
+        sim.step(n)
+        os.makedirs(cache, exist_ok=True)
+        sim.save_checkpoint(path)
+    return path
+
+
+def run_demfem(e: float, steps: int, settle: int, threads: int, start: str, load: str | None = None) -> dict:
+    from demfem.dem import DemSimulation
+
+    sim = DemSimulation.anchor_table(e, start=start, threads=threads, initial_vx=0.2 if load else 0.0)
+    if load:
+        sim.load_checkpoint(load)
+    else:
+        sim.step(settle)
     t0 = time.perf_counter()
     sim.step(steps, chunk=steps)
     wall = time.perf_counter() - t0
@@ -59,31 +88,56 @@ def main() -> None:
     p.add_argument("--threads", type=int, nargs="+", default=[1, 2])
     p.add_argument("--skip-yade", action="store_true")
     p.add_argument("--skip-liggghts", action="store_true")
+    p.add_argument("--state", choices=["start", "packed"], default="start",
+                   help="start: square packing after --settle steps; packed: each code's packed state "
+                        "made by the anchors' recipe (bench_all.py prepare; demfem's own made and cached here)")
+    p.add_argument("--reps", type=int, default=1, help="repetitions; the median is reported")
+    p.add_argument("--cache", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), ".states"),
+                   help="where demfem's packed state is cached")
     a = p.parse_args()
     anchors = os.path.abspath(ANCHORS)
+    packed = a.state == "packed"
+    if packed:
+        sys.path.insert(0, anchors)
+        import bench_all  # noqa: E402
+
+        lig_state, yade_state = bench_all.state_file("liggghts", a.E), bench_all.state_file("yade", a.E)
+        for f in (lig_state, yade_state):
+            if not os.path.exists(f):
+                sys.exit(f"missing anchor state {f}: run `python3 bench_all.py prepare --E {a.E:g}` in {anchors}")
+        ours_state = demfem_packed_state(a.E, anchors, a.cache)
     rows = []
-    for t in a.threads:
-        rows.append(run_demfem(a.E, a.steps, a.settle, t, "square"))
     with tempfile.TemporaryDirectory() as tmp:
-        if not a.skip_liggghts:
-            r = run_anchor([sys.executable, os.path.join(anchors, "run_liggghts.py"), "--E", str(a.E), "--steps", str(a.steps),
-                            "--settle", str(a.settle), "--np", "1", "--dir", os.path.join(tmp, "lig")], tmp)
-            r["code"], r["threads"] = "liggghts", 1
-            rows.append(r)
-        if not a.skip_yade:
-            r = run_anchor(["yade", "-n", "-x", "-j1", os.path.join(anchors, "yade_bench.py"), "--E", str(a.E),
-                            "--steps", str(a.steps), "--settle", str(a.settle)], tmp)
-            r["code"], r["threads"] = "yade", 1
-            rows.append(r)
-    ours = {r["threads"]: r["particle_steps_per_s"] for r in rows if r["code"] == "demfem"}
-    print(f"start state, E = {a.E:g} Pa, {a.steps} timed steps after {a.settle} settle steps")
-    print(f"{'code':10s} {'threads':>7s} {'particle-steps/s':>17s} {'wall s':>8s}")
-    for r in rows:
-        print(f"{r['code']:10s} {r['threads']:>7} {r['particle_steps_per_s']:17.3e} {r['wall_s']:8.2f}")
-    for r in rows:
-        if r["code"] != "demfem":
-            for t, v in sorted(ours.items()):
-                print(f"demfem {t} thread(s) / {r['code']} 1: {v / r['particle_steps_per_s']:.2f}x")
+        for _rep in range(a.reps):
+            for t in a.threads:
+                rows.append(run_demfem(a.E, a.steps, a.settle, t, "square", ours_state if packed else None))
+            if not a.skip_liggghts:
+                cmd = [sys.executable, os.path.join(anchors, "run_liggghts.py"), "--E", str(a.E),
+                       "--steps", str(a.steps), "--np", "1", "--dir", os.path.join(tmp, "lig")]
+                cmd += ["--settle", "0", "--load-restart", lig_state] if packed else ["--settle", str(a.settle)]
+                r = run_anchor(cmd, tmp)
+                r["code"], r["threads"] = "liggghts", 1
+                rows.append(r)
+            if not a.skip_yade:
+                cmd = ["yade", "-n", "-x", "-j1", os.path.join(anchors, "yade_bench.py"), "--E", str(a.E),
+                       "--steps", str(a.steps)]
+                cmd += ["--settle", "0", "--load", yade_state] if packed else ["--settle", str(a.settle)]
+                r = run_anchor(cmd, tmp)
+                r["code"], r["threads"] = "yade", 1
+                rows.append(r)
+    med: dict[tuple[str, int], float] = {}
+    for key in sorted({(r["code"], r["threads"]) for r in rows}):
+        med[key] = statistics.median(r["particle_steps_per_s"] for r in rows if (r["code"], r["threads"]) == key)
+    what = "packed state (each code's own, anchors' recipe)" if packed else f"start state after {a.settle} settle steps"
+    print(f"{what}, E = {a.E:g} Pa, {a.steps} timed steps, median of {a.reps}")
+    print(f"{'code':10s} {'threads':>7s} {'particle-steps/s':>17s}")
+    for (code, t), v in med.items():
+        print(f"{code:10s} {t:>7} {v:17.3e}")
+    for (code, t), v in med.items():
+        if code != "demfem":
+            for (c2, t2), ours in med.items():
+                if c2 == "demfem":
+                    print(f"demfem {t2} thread(s) / {code} {t}: {ours / v:.2f}x")
 
 
 if __name__ == "__main__":

@@ -47,7 +47,7 @@ fn bench_threads(c: &mut Criterion, bytes: &[u8]) {
     g.sample_size(10)
         .warm_up_time(Duration::from_secs(1))
         .measurement_time(Duration::from_secs(4));
-    for threads in [1usize, 2] {
+    for (threads, avx2) in [(1usize, true), (2, true), (1, false)] {
         // restore the exact packed state (history included) rather than the copied initial data
         let mut sim = {
             let mut fresh = anchor_scene(45e9, TableStart::PackedIntoFunnel).expect("scene");
@@ -60,7 +60,17 @@ fn bench_threads(c: &mut Criterion, bytes: &[u8]) {
                 .expect("restore");
             sim
         };
-        g.bench_function(format!("threads_{threads}"), |b| {
+        // the AVX2 build of the kernels where the CPU has it; the baseline build for comparison
+        let simd = sim.set_avx2(avx2);
+        let name = if avx2 {
+            format!("threads_{threads}")
+        } else {
+            format!("threads_{threads}_baseline_no_avx2")
+        };
+        if avx2 && !simd {
+            eprintln!("no AVX2 on this CPU: {name} runs the baseline build");
+        }
+        g.bench_function(name, |b| {
             b.iter(|| sim.step(STEPS_PER_ITER).expect("step"))
         });
     }

@@ -53,6 +53,9 @@ fn main() {
                 scene.effects = scene.effects.with(Effect::RollingResistance);
                 scene.materials[0].rolling_friction = 0.01;
             }
+            other if other.starts_with("skin=") => {
+                scene.skin = Some(other[5..].parse().unwrap());
+            }
             other => panic!("unknown variant {other}"),
         }
         sim = Simulation::new(&scene).unwrap();

@@ -1,6 +1,7 @@
 //! Threads and restarts must not change results: 1 and 2 threads give bitwise identical
 //! states, and a run restored from a checkpoint continues bitwise identically to an
-//! uninterrupted one (tangential history included).
+//! uninterrupted one (tangential history included); the AVX2 and baseline builds of the
+//! step kernels agree bitwise.
 
 use demfem::dem::table::{anchor_scene, TableStart};
 use demfem::dem::Simulation;
@@ -41,6 +42,23 @@ fn one_and_two_threads_are_bitwise_identical() {
     assert_eq!(bits(&a), bits(&b));
     assert_eq!(a.onsets(), b.onsets());
     assert_eq!(a.onsets().is_empty(), false);
+}
+
+#[test]
+fn avx2_and_baseline_kernels_are_bitwise_identical() {
+    let mut a = packed_soft(1);
+    let mut b = packed_soft(2);
+    a.set_avx2(false);
+    let simd = b.set_avx2(true);
+    assert!(!a.uses_avx2());
+    if !simd {
+        eprintln!("this CPU has no AVX2: only the baseline build can run here");
+    }
+    a.step(3000).unwrap();
+    b.step(3000).unwrap();
+    assert!(a.contacts().len() > 500);
+    assert_eq!(bits(&a), bits(&b));
+    assert_eq!(a.onsets(), b.onsets());
 }
 
 #[test]

@@ -205,6 +205,8 @@ pub struct Simulation {
     pub(crate) stable: StableStep,
     pub(crate) skin: f64,
     pub(crate) threads: usize,
+    /// Step with the AVX2 build of the kernels (bitwise the same results; see `simd`).
+    avx2: bool,
     pub(crate) record_every: u64,
     pub(crate) record_onsets: bool,
     /// Outlet plane (point, unit normal towards the kept side).
@@ -408,6 +410,19 @@ fn tangential_force(
     f_t
 }
 
+/// Whether the step may use its AVX2 build: the CPU has AVX2 and `DEMFEM_NO_AVX2` is unset
+/// (the variable forces the baseline build, e.g. to compare the two).
+fn cpu_has_avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::env::var_os("DEMFEM_NO_AVX2").is_none() && std::arch::is_x86_feature_detected!("avx2")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
 /// `E` value of the kernels' const generic that reads the effect set at run time; any other
 /// value is the effect bit set itself, so `on::<E>` folds to a constant and the specialised
 /// kernels carry no effect tests (see [`Simulation::step`] for the specialised sets).
@@ -560,6 +575,153 @@ fn pair_kernel<const E: u16>(
     onset
 }
 
+/// Pair kernels of one chunk of the pair list; returns the number of onsets.
+#[inline(always)]
+fn pair_chunk<const E: u16>(
+    chunk: &mut [PairContact],
+    out: &mut [PairOut],
+    konst: &[ContactConst],
+    c: &PairCtx<'_>,
+) -> u32 {
+    let mut onsets = 0u32;
+    for ((p, o), k) in chunk.iter_mut().zip(out.iter_mut()).zip(konst) {
+        onsets += pair_kernel::<E>(p, k, o, c) as u32;
+    }
+    onsets
+}
+
+/// The kernel entry points ([`pair_chunk`], [`wall_chunk`], [`particle_chunk`]) compiled a
+/// second time for AVX2, and chosen per chunk by `avx2` (set when the CPU has it; see
+/// [`cpu_has_avx2`]). The AVX2 build runs the same IEEE operations in the same order (Rust
+/// never fuses a multiply and an add on its own), so results are bitwise those of the
+/// baseline build; the VEX three-operand encoding drops most of the register moves SSE2
+/// needs around glam's three-component vectors.
+mod simd {
+    use super::*;
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn pair_chunk_avx2<const E: u16>(
+        chunk: &mut [PairContact],
+        out: &mut [PairOut],
+        konst: &[ContactConst],
+        c: &PairCtx<'_>,
+    ) -> u32 {
+        pair_chunk::<E>(chunk, out, konst, c)
+    }
+
+    #[inline(always)]
+    pub(super) fn pair<const E: u16>(
+        avx2: bool,
+        chunk: &mut [PairContact],
+        out: &mut [PairOut],
+        konst: &[ContactConst],
+        c: &PairCtx<'_>,
+    ) -> u32 {
+        #[cfg(target_arch = "x86_64")]
+        if avx2 {
+            // SAFETY: `avx2` is true only when the CPU reported AVX2.
+            return unsafe { pair_chunk_avx2::<E>(chunk, out, konst, c) };
+        }
+        let _ = avx2;
+        pair_chunk::<E>(chunk, out, konst, c)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn wall_chunk_avx2<const E: u16>(c: &WallCtx<'_>, first: usize, slots: &mut [WallContact]) {
+        wall_chunk::<E>(c, first, slots)
+    }
+
+    #[inline(always)]
+    pub(super) fn wall<const E: u16>(
+        avx2: bool,
+        c: &WallCtx<'_>,
+        first: usize,
+        slots: &mut [WallContact],
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if avx2 {
+            // SAFETY: `avx2` is true only when the CPU reported AVX2.
+            return unsafe { wall_chunk_avx2::<E>(c, first, slots) };
+        }
+        let _ = avx2;
+        wall_chunk::<E>(c, first, slots)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[allow(clippy::too_many_arguments)]
+    fn particle_chunk_avx2<const E: u16>(
+        c: &ParticleCtx<'_>,
+        first: usize,
+        position: &mut [Vec3],
+        velocity: &mut [Vec3],
+        omega: &mut [Vec3],
+        force_sum: &mut [Vec3],
+        coordination: &mut [u32],
+        wall_coordination: &mut [u32],
+        slots: &[WallContact],
+    ) -> (f64, bool, u32) {
+        particle_chunk::<E>(
+            c,
+            first,
+            position,
+            velocity,
+            omega,
+            force_sum,
+            coordination,
+            wall_coordination,
+            slots,
+        )
+    }
+
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn particle<const E: u16>(
+        avx2: bool,
+        c: &ParticleCtx<'_>,
+        first: usize,
+        position: &mut [Vec3],
+        velocity: &mut [Vec3],
+        omega: &mut [Vec3],
+        force_sum: &mut [Vec3],
+        coordination: &mut [u32],
+        wall_coordination: &mut [u32],
+        slots: &[WallContact],
+    ) -> (f64, bool, u32) {
+        #[cfg(target_arch = "x86_64")]
+        if avx2 {
+            // SAFETY: `avx2` is true only when the CPU reported AVX2.
+            return unsafe {
+                particle_chunk_avx2::<E>(
+                    c,
+                    first,
+                    position,
+                    velocity,
+                    omega,
+                    force_sum,
+                    coordination,
+                    wall_coordination,
+                    slots,
+                )
+            };
+        }
+        let _ = avx2;
+        particle_chunk::<E>(
+            c,
+            first,
+            position,
+            velocity,
+            omega,
+            force_sum,
+            coordination,
+            wall_coordination,
+            slots,
+        )
+    }
+}
+
 /// Closest point, unit normal (wall → x) and distance of a wall slot when the sphere of
 /// radius r touches it. Half-spaces (the belt) by hand: one dot product, nothing else when
 /// out of reach.
@@ -703,6 +865,7 @@ fn wall_chunk<const E: u16>(c: &WallCtx<'_>, first: usize, slots: &mut [WallCont
 /// Particle phase on one chunk of particles starting at `first`. Returns (largest squared
 /// displacement since the last rebuild, any non-finite value, wall onsets).
 #[allow(clippy::too_many_arguments)]
+#[inline(always)]
 fn particle_chunk<const E: u16>(
     c: &ParticleCtx<'_>,
     first: usize,
@@ -921,6 +1084,7 @@ impl Simulation {
             stable,
             skin,
             threads: scene.threads,
+            avx2: cpu_has_avx2(),
             record_every: scene.record_every,
             record_onsets: scene.record_onsets,
             removal_plane: scene.removal_plane.map(|(p, n)| (p, n / n.length())),
@@ -1218,6 +1382,7 @@ impl Simulation {
     /// Pair phase and particle phase of one step, specialised on the effect set `E`.
     fn force_and_advance<const E: u16>(&mut self, parallel: bool) {
         let stride = self.wall_stride;
+        let avx2 = self.avx2;
         // rayon may split each parallel loop into at most about two tasks per thread: the step
         // lasts microseconds, so fewer, larger tasks beat finer load balancing
         let tasks = 2 * self.threads.max(1);
@@ -1257,13 +1422,7 @@ impl Simulation {
                 (&mut [PairContact], &mut [PairOut]),
                 &[ContactConst],
             )|
-             -> u32 {
-                let mut onsets = 0u32;
-                for ((p, o), k) in chunk.iter_mut().zip(out.iter_mut()).zip(konst) {
-                    onsets += pair_kernel::<E>(p, k, o, &pair_ctx) as u32;
-                }
-                onsets
-            };
+             -> u32 { simd::pair::<E>(avx2, chunk, out, konst, &pair_ctx) };
             let (pairs, pair_out, pair_const) =
                 (&mut self.pairs, &mut self.pair_out, &self.pair_const);
             let (onsets, slots) = (&mut self.chunk_onsets, &mut self.wall_slots);
@@ -1283,7 +1442,9 @@ impl Simulation {
                             .par_chunks_mut(PARTICLE_CHUNK * stride)
                             .enumerate()
                             .with_min_len(particle_min)
-                            .for_each(|(c, s)| wall_chunk::<E>(&wall_ctx, c * PARTICLE_CHUNK, s))
+                            .for_each(|(c, s)| {
+                                simd::wall::<E>(avx2, &wall_ctx, c * PARTICLE_CHUNK, s)
+                            })
                     },
                 );
             } else {
@@ -1295,7 +1456,7 @@ impl Simulation {
                 {
                     onsets.push(kernel(chunk));
                 }
-                wall_chunk::<E>(&wall_ctx, 0, slots);
+                simd::wall::<E>(avx2, &wall_ctx, 0, slots);
             }
         }
         // ---- particle phase: gather in list order, advance
@@ -1328,7 +1489,7 @@ impl Simulation {
                     .enumerate()
                     .with_min_len(particle_min)
                     .map(|(c, ((((((x, v), w), f), z), zw), s))| {
-                        particle_chunk::<E>(&ctx, c * PARTICLE_CHUNK, x, v, w, f, z, zw, s)
+                        simd::particle::<E>(avx2, &ctx, c * PARTICLE_CHUNK, x, v, w, f, z, zw, s)
                     })
                     .collect_into_vec(&mut self.chunk_results);
             } else {
@@ -1344,7 +1505,8 @@ impl Simulation {
                     .zip(self.wall_slots.chunks(PARTICLE_CHUNK * stride))
                     .enumerate();
                 for (c, ((((((x, v), w), f), z), zw), s)) in iter {
-                    self.chunk_results.push(particle_chunk::<E>(
+                    self.chunk_results.push(simd::particle::<E>(
+                        avx2,
                         &ctx,
                         c * PARTICLE_CHUNK,
                         x,
@@ -1511,6 +1673,20 @@ impl Simulation {
     pub fn stable_step(&self) -> &StableStep {
         &self.stable
     }
+    /// Whether the step runs its AVX2 build of the kernels (x86-64 CPUs with AVX2, unless the
+    /// environment variable `DEMFEM_NO_AVX2` was set when the simulation was built).
+    pub fn uses_avx2(&self) -> bool {
+        self.avx2
+    }
+
+    /// Choose the AVX2 build (`true`, taken only if the CPU has AVX2) or the baseline build
+    /// (`false`) of the step kernels; returns the build now in use. Both give bitwise the same
+    /// results (a test checks it); this exists to compare their speed and to test that.
+    pub fn set_avx2(&mut self, on: bool) -> bool {
+        self.avx2 = on && cpu_has_avx2();
+        self.avx2
+    }
+
     /// Worker threads the simulation was built with.
     pub fn threads(&self) -> usize {
         self.threads
