@@ -316,9 +316,10 @@ type RadiusOf<'a> = &'a dyn Fn(u32) -> f64;
 /// Local overlap of two convex pieces at a manifold point, measured along the manifold
 /// normal `n` (world, from piece 1 to piece 2), m; `None` when the surfaces do not overlap
 /// there. From `p1` (on piece 1) a ray starts `LOCAL_OVERLAP_RAY_START` behind it (outside
-/// piece 2 for a valid normal, see [`normal_is_valid`]) and runs along +n to piece 2's surface; the overlap is how far that surface lies behind `p1`.
-/// The same from `p2` towards piece 1 along −n; the larger of the two counts (a rim point is
-/// measured well from its own side). Frames piece → world.
+/// piece 2 for a valid normal, see [`normal_is_valid`]) and runs along +n to piece 2's
+/// surface; the overlap is how far that surface lies behind `p1`. The same from `p2` towards
+/// piece 1 along −n; the larger of the two counts (a rim point is measured well from its own
+/// side). Frames piece → world.
 #[allow(clippy::too_many_arguments)]
 fn local_overlap(
     piece1: &dyn Shape,
@@ -377,7 +378,9 @@ const LOCAL_OVERLAP_RAY_START: f64 = 1e-3;
 
 /// Contact points of two shapes from parry's manifolds, world frame (see the module docs).
 ///
-/// Two things about parry's manifolds matter for forces and are corrected here:
+/// Three things about parry's manifolds matter for forces and are corrected here (the
+/// scene then lets all points of one piece pair share one Hertz law, see
+/// `scene::piece_pair_share`):
 ///
 /// * Spatial coherence. Parry reuses a manifold's points from the previous query while the
 ///   normal has turned less than 1° and the points have slid less than 1 mm (thresholds

@@ -16,7 +16,10 @@
 //! once, each carries the Tsuji damping of m*/n: n springs of similar stiffness k act as one
 //! spring nk on the mass m*, and ζ √(m* nk) = n · ζ √((m*/n) k). With the whole m* per point
 //! the pair would be √n times over-damped (a cartridge hitting a wall with its side touches
-//! with ~60 beads at once and would keep a restitution of ~0.15 instead of 0.5).
+//! with ~60 beads at once and would keep a restitution of ~0.15 instead of 0.5). Between two
+//! exact shapes a contact is a piece pair: its parry points share one Hertz law and one m*/n
+//! (n = piece pairs touching), so the force does not jump with the number of points parry
+//! reports from one step to the next.
 
 use std::collections::{HashMap, HashSet};
 use std::hash::{BuildHasherDefault, Hasher};
