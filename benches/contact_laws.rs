@@ -9,7 +9,13 @@ fn bench_laws(c: &mut Criterion) {
     let laws = [
         ("hertz", NormalLaw::Hertz { k_h: 3.0e10 }),
         ("linear", NormalLaw::Linear { k: 2.0e7 }),
-        ("hertz_reissner", NormalLaw::HertzReissner { k_h: 3.0e10, k_r: 4.0e6 }),
+        (
+            "hertz_reissner",
+            NormalLaw::HertzReissner {
+                k_h: 3.0e10,
+                k_r: 4.0e6,
+            },
+        ),
     ];
     let mut g = c.benchmark_group("normal_force_1024");
     for (name, law) in laws {

@@ -35,10 +35,17 @@ fn arg<T: std::str::FromStr>(args: &[String], name: &str, default: T) -> T {
 /// CPU time (user + system, all threads) of this process, s, from /proc/self/stat
 /// (clock ticks of 10 ms on Linux); NaN where unavailable.
 fn process_cpu_time() -> f64 {
-    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else { return f64::NAN };
-    let Some(rest) = stat.rsplit_once(')').map(|p| p.1) else { return f64::NAN };
+    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
+        return f64::NAN;
+    };
+    let Some(rest) = stat.rsplit_once(')').map(|p| p.1) else {
+        return f64::NAN;
+    };
     let f: Vec<&str> = rest.split_whitespace().collect();
-    match (f.get(11).and_then(|v| v.parse::<f64>().ok()), f.get(12).and_then(|v| v.parse::<f64>().ok())) {
+    match (
+        f.get(11).and_then(|v| v.parse::<f64>().ok()),
+        f.get(12).and_then(|v| v.parse::<f64>().ok()),
+    ) {
         (Some(u), Some(s)) => (u + s) / 100.0,
         _ => f64::NAN,
     }
@@ -65,20 +72,34 @@ fn main() -> demfem::Result<()> {
         .filter(|&i| {
             let x = mesh.nodes[i];
             let r = (x[0] * x[0] + x[1] * x[1]).sqrt();
-            (r - R_OUT).abs() < 1e-9 && ((x[0] - R_OUT).powi(2) + x[1].powi(2) + (x[2] - Z0).powi(2)).sqrt() < patch
+            (r - R_OUT).abs() < 1e-9
+                && ((x[0] - R_OUT).powi(2) + x[1].powi(2) + (x[2] - Z0).powi(2)).sqrt() < patch
         })
         .collect();
     let fixed: Vec<usize> = (0..n).filter(|&i| mesh.nodes[i][2] < 1e-9).collect();
-    let k_mid = rm.z_stations.iter().enumerate().min_by(|a, b| (a.1 - Z0).abs().total_cmp(&(b.1 - Z0).abs())).unwrap().0;
+    let k_mid = rm
+        .z_stations
+        .iter()
+        .enumerate()
+        .min_by(|a, b| (a.1 - Z0).abs().total_cmp(&(b.1 - Z0).abs()))
+        .unwrap()
+        .0;
     let probe = rm.node_index(0, layers, k_mid);
     let mesh_time = t0.elapsed().as_secs_f64();
 
     if !mesh_out.is_empty() {
-        let mut f = std::io::BufWriter::new(std::fs::File::create(&mesh_out).expect("cannot create mesh file"));
-        let w = |f: &mut std::io::BufWriter<std::fs::File>, s: String| f.write_all(s.as_bytes()).expect("write");
+        let mut f = std::io::BufWriter::new(
+            std::fs::File::create(&mesh_out).expect("cannot create mesh file"),
+        );
+        let w = |f: &mut std::io::BufWriter<std::fs::File>, s: String| {
+            f.write_all(s.as_bytes()).expect("write")
+        };
         w(&mut f, format!("{} {}\n", n, mesh.n_elements()));
         for x in &mesh.nodes {
-            w(&mut f, format!("{:.17e} {:.17e} {:.17e}\n", x[0], x[1], x[2]));
+            w(
+                &mut f,
+                format!("{:.17e} {:.17e} {:.17e}\n", x[0], x[1], x[2]),
+            );
         }
         for t in &mesh.tets {
             w(&mut f, format!("{} {} {} {}\n", t[0], t[1], t[2], t[3]));
@@ -104,16 +125,25 @@ fn main() -> demfem::Result<()> {
     cfg.energy_interval = 0;
     cfg.step_bound = match bound.as_str() {
         "element" => StepBound::ElementEigenvalue,
-        _ => StepBound::CertifiedGlobal { margin: 0.01, iterations: 400 },
+        _ => StepBound::CertifiedGlobal {
+            margin: 0.01,
+            iterations: 400,
+        },
     };
     if dt_arg > 0.0 {
         cfg.dt = Some(dt_arg);
     }
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("thread pool");
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("thread pool");
     pool.install(|| -> demfem::Result<()> {
         let t1 = Instant::now();
         let mut solver = ExplicitSolver::new(mesh, cfg)?;
-        let bcs: Vec<Prescribed> = fixed.iter().flat_map(|&i| Prescribed::fix_node(i)).collect();
+        let bcs: Vec<Prescribed> = fixed
+            .iter()
+            .flat_map(|&i| Prescribed::fix_node(i))
+            .collect();
         solver.set_prescribed(&bcs, demfem::fem::LoadHistory::Constant)?;
         let mut v = vec![[0.0; 3]; n];
         for &i in &kick {
@@ -129,18 +159,50 @@ fn main() -> demfem::Result<()> {
         let u = solver.displacement().to_vec();
         let mut f = vec![[0.0; 3]; n];
         solver.kernel_mut().apply(&u, &mut f);
-        let strain_energy: f64 = 0.5 * u.iter().zip(&f).map(|(a, b)| a[0] * b[0] + a[1] * b[1] + a[2] * b[2]).sum::<f64>();
+        let strain_energy: f64 = 0.5
+            * u.iter()
+                .zip(&f)
+                .map(|(a, b)| a[0] * b[0] + a[1] * b[1] + a[2] * b[2])
+                .sum::<f64>();
         // Kinetic energy with the last half-step velocity (the one that moved u to t^N).
-        let kinetic: f64 = 0.5 * solver.mass().iter().zip(solver.velocity()).map(|(m, v)| m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2])).sum::<f64>();
-        println!("nodes {n}\ntets {}\nkick_nodes {}\nfixed_nodes {}\nprobe {probe}", mesh.n_elements(), kick.len(), fixed.len());
-        println!("threads {threads}\ndt {:.6e}\ndt_limit {:.6e}\nsteps {steps}\ntime {:.6e}", solver.dt(), solver.dt_limit(), solver.time());
+        let kinetic: f64 = 0.5
+            * solver
+                .mass()
+                .iter()
+                .zip(solver.velocity())
+                .map(|(m, v)| m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]))
+                .sum::<f64>();
+        println!(
+            "nodes {n}\ntets {}\nkick_nodes {}\nfixed_nodes {}\nprobe {probe}",
+            mesh.n_elements(),
+            kick.len(),
+            fixed.len()
+        );
+        println!(
+            "threads {threads}\ndt {:.6e}\ndt_limit {:.6e}\nsteps {steps}\ntime {:.6e}",
+            solver.dt(),
+            solver.dt_limit(),
+            solver.time()
+        );
         println!("mesh_time {mesh_time:.4}\nsetup_time {setup_time:.4}\nstep_time {step_time:.4}");
         println!("step_cpu {step_cpu:.4}");
-        println!("element_steps_per_s {:.6e}", mesh.n_elements() as f64 * steps as f64 / step_time);
-        println!("element_steps_per_cpu_s {:.6e}", mesh.n_elements() as f64 * steps as f64 / step_cpu);
-        println!("probe_u {:.9e} {:.9e} {:.9e}", u[probe][0], u[probe][1], u[probe][2]);
+        println!(
+            "element_steps_per_s {:.6e}",
+            mesh.n_elements() as f64 * steps as f64 / step_time
+        );
+        println!(
+            "element_steps_per_cpu_s {:.6e}",
+            mesh.n_elements() as f64 * steps as f64 / step_cpu
+        );
+        println!(
+            "probe_u {:.9e} {:.9e} {:.9e}",
+            u[probe][0], u[probe][1], u[probe][2]
+        );
         println!("strain_energy {strain_energy:.9e}\nkinetic_energy {kinetic:.9e}");
-        println!("initial_kinetic {:.9e}", 0.5 * kick.iter().map(|&i| solver.mass()[i]).sum::<f64>() * v0 * v0);
+        println!(
+            "initial_kinetic {:.9e}",
+            0.5 * kick.iter().map(|&i| solver.mass()[i]).sum::<f64>() * v0 * v0
+        );
         Ok(())
     })
 }

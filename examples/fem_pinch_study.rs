@@ -17,7 +17,13 @@ fn main() -> demfem::Result<()> {
     let p = AxisymmetricProfile::default_cartridge();
     let glass = LinearElastic::paper_glass();
     println!("model        n_theta  layers  elements   dofs    σ1_peak(MPa)  wall(s)");
-    for (n_theta, layers, h) in [(48, 1, 0.6e-3), (64, 2, 0.5e-3), (64, 3, 0.5e-3), (64, 4, 0.5e-3), (96, 4, 0.35e-3)] {
+    for (n_theta, layers, h) in [
+        (48, 1, 0.6e-3),
+        (64, 2, 0.5e-3),
+        (64, 3, 0.5e-3),
+        (64, 4, 0.5e-3),
+        (96, 4, 0.35e-3),
+    ] {
         let t0 = Instant::now();
         let rm = p.tet_mesh(n_theta, layers, h)?;
         let m = &rm.mesh;
@@ -29,7 +35,9 @@ fn main() -> demfem::Result<()> {
                 .filter(|&i| {
                     let x = m.nodes[i];
                     let r = (x[0] * x[0] + x[1] * x[1]).sqrt();
-                    (r - r_out).abs() < 1e-9 && ((x[0] - c[0]).powi(2) + x[1].powi(2) + (x[2] - c[2]).powi(2)).sqrt() < PATCH
+                    (r - r_out).abs() < 1e-9
+                        && ((x[0] - c[0]).powi(2) + x[1].powi(2) + (x[2] - c[2]).powi(2)).sqrt()
+                            < PATCH
                 })
                 .collect();
             for &i in &sel {
@@ -40,12 +48,25 @@ fn main() -> demfem::Result<()> {
         let a = rm.node_index(0, 0, 0);
         let b = rm.node_index(n_theta / 2, 0, 0);
         let c = rm.node_index(n_theta / 4, 0, 0);
-        let fixed = [(a, 0, 0.0), (a, 1, 0.0), (a, 2, 0.0), (b, 1, 0.0), (b, 2, 0.0), (c, 2, 0.0)];
+        let fixed = [
+            (a, 0, 0.0),
+            (a, 1, 0.0),
+            (a, 2, 0.0),
+            (b, 1, 0.0),
+            (b, 2, 0.0),
+            (c, 2, 0.0),
+        ];
         let sol = solve_static(m, &glass, &loads, &fixed)?;
-        let s1 = element_stresses(m, &glass, &sol.displacement)?.iter().map(max_principal_stress).fold(f64::MIN, f64::max);
+        let s1 = element_stresses(m, &glass, &sol.displacement)?
+            .iter()
+            .map(max_principal_stress)
+            .fold(f64::MIN, f64::max);
         println!(
             "tet          {n_theta:7} {layers:7} {:9} {:7} {:13.2} {:8.2}",
-            m.n_elements(), 3 * m.n_nodes(), s1 / 1e6, t0.elapsed().as_secs_f64()
+            m.n_elements(),
+            3 * m.n_nodes(),
+            s1 / 1e6,
+            t0.elapsed().as_secs_f64()
         );
     }
     for (n_theta, h) in [(48, 0.6e-3), (64, 0.5e-3), (96, 0.35e-3), (128, 0.25e-3)] {
@@ -59,7 +80,8 @@ fn main() -> demfem::Result<()> {
             let sel: Vec<usize> = (0..m.nodes.len())
                 .filter(|&i| {
                     let x = m.nodes[i];
-                    ((x[0] - sign * r_mid).powi(2) + x[1].powi(2) + (x[2] - Z0).powi(2)).sqrt() < PATCH
+                    ((x[0] - sign * r_mid).powi(2) + x[1].powi(2) + (x[2] - Z0).powi(2)).sqrt()
+                        < PATCH
                 })
                 .collect();
             for &i in &sel {
@@ -67,12 +89,26 @@ fn main() -> demfem::Result<()> {
             }
         }
         let idx = |i: usize| i; // station 0 ring: node i = θ index i
-        let fixed = [(idx(0), 0, 0.0), (idx(0), 1, 0.0), (idx(0), 2, 0.0), (idx(n_theta / 2), 1, 0.0), (idx(n_theta / 2), 2, 0.0), (idx(n_theta / 4), 2, 0.0)];
+        let fixed = [
+            (idx(0), 0, 0.0),
+            (idx(0), 1, 0.0),
+            (idx(0), 2, 0.0),
+            (idx(n_theta / 2), 1, 0.0),
+            (idx(n_theta / 2), 2, 0.0),
+            (idx(n_theta / 4), 2, 0.0),
+        ];
         let x = model.solve_static(&f, &fixed)?;
-        let s1 = model.max_principal_stresses(&x)?.iter().flat_map(|s| s.iter().cloned()).fold(f64::MIN, f64::max);
+        let s1 = model
+            .max_principal_stresses(&x)?
+            .iter()
+            .flat_map(|s| s.iter().cloned())
+            .fold(f64::MIN, f64::max);
         println!(
             "shell        {n_theta:7}       - {:9} {:7} {:13.2} {:8.2}",
-            m.triangles.len(), model.n_dofs(), s1 / 1e6, t0.elapsed().as_secs_f64()
+            m.triangles.len(),
+            model.n_dofs(),
+            s1 / 1e6,
+            t0.elapsed().as_secs_f64()
         );
     }
     Ok(())

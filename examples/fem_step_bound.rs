@@ -12,7 +12,13 @@ fn main() -> demfem::Result<()> {
     for layers in 1..=4 {
         let mesh = p.tet_mesh(52, layers, 0.55e-3)?.mesh;
         let mut res = Vec::new();
-        for bound in [StepBound::ElementEigenvalue, StepBound::CertifiedGlobal { margin: 0.01, iterations: 400 }] {
+        for bound in [
+            StepBound::ElementEigenvalue,
+            StepBound::CertifiedGlobal {
+                margin: 0.01,
+                iterations: 400,
+            },
+        ] {
             let mut cfg = ExplicitConfig::new(LinearElastic::paper_glass());
             cfg.step_bound = bound;
             let t0 = Instant::now();
@@ -21,7 +27,12 @@ fn main() -> demfem::Result<()> {
         }
         println!(
             "{layers:6} {:7} {:14.4e} {:9.2} {:16.4e} {:9.2} {:6.3}",
-            mesh.n_elements(), res[0].0, res[0].1, res[1].0, res[1].1, res[1].0 / res[0].0
+            mesh.n_elements(),
+            res[0].0,
+            res[0].1,
+            res[1].0,
+            res[1].1,
+            res[1].0 / res[0].0
         );
     }
     Ok(())

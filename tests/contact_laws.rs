@@ -51,7 +51,10 @@ fn integrate(force: impl Fn(f64, f64) -> f64, m: f64, v0: f64, t_est: f64) -> Im
 fn pair_constants() -> (f64, f64) {
     let e_star = effective_modulus(E, NU, E, NU).unwrap();
     let r_star = effective_radius(RADIUS, RADIUS).unwrap();
-    (hertz_stiffness(r_star, e_star).unwrap(), effective_mass(MASS, MASS).unwrap())
+    (
+        hertz_stiffness(r_star, e_star).unwrap(),
+        effective_mass(MASS, MASS).unwrap(),
+    )
 }
 
 #[test]
@@ -64,7 +67,12 @@ fn hertz_impact_matches_closed_form() {
         // Verlet with dt = 1e-5 t_c: errors O(dt²) ≈ 1e-9; 1e-6 leaves room for sampling
         assert!((imp.max_force / max_force_hertz(k_h, m, v) - 1.0).abs() < 1e-6);
         assert!((imp.max_overlap / hertz_max_overlap(k_h, m, v) - 1.0).abs() < 1e-6);
-        assert!((imp.duration / tc - 1.0).abs() < 1e-5, "{} vs {}", imp.duration, tc);
+        assert!(
+            (imp.duration / tc - 1.0).abs() < 1e-5,
+            "{} vs {}",
+            imp.duration,
+            tc
+        );
         assert!((imp.exit_speed / v - 1.0).abs() < 1e-6);
     }
 }
@@ -80,7 +88,11 @@ fn hertz_reissner_impact_matches_eq12() {
         let f_theory = max_force_hertz_reissner(k_h, k_r, m, v);
         let tc = hertz_contact_duration(k_h, m, v).unwrap() * 3.0;
         let imp = integrate(|x, _| law.force(x), m, v, tc);
-        assert!((imp.max_force / f_theory - 1.0).abs() < 1e-6, "{} vs {f_theory}", imp.max_force);
+        assert!(
+            (imp.max_force / f_theory - 1.0).abs() < 1e-6,
+            "{} vs {f_theory}",
+            imp.max_force
+        );
         // the series law is softer than either law alone
         assert!(f_theory < max_force_hertz(k_h, m, v));
         assert!(f_theory < max_force_linear(k_r, m, v));
@@ -157,7 +169,10 @@ fn tsuji_damping_realises_restitution_in_dimensional_impacts() {
                 // with clamping the bodies separate when the force vanishes, before x = 0:
                 // the exit speed is then constant, so x = 0 measures it as well
                 let e_real = imp.exit_speed / v;
-                assert!((e_real - e).abs() < 2e-4, "e={e} clamp={clamp:?} v={v}: {e_real}");
+                assert!(
+                    (e_real - e).abs() < 2e-4,
+                    "e={e} clamp={clamp:?} v={v}: {e_real}"
+                );
             }
         }
     }

@@ -7,7 +7,9 @@ use demfem::fem::assembly::surface_pressure_loads;
 use demfem::fem::mesh::{AxisymmetricProfile, RevolvedTetMesh};
 use demfem::fem::static_solve::solve_static;
 use demfem::fem::stress::{element_stresses, nodal_stresses, stress_along_line};
-use demfem::fem::{ExplicitConfig, ExplicitSolver, LinearElastic, LoadHistory, Prescribed, PrescribedKind};
+use demfem::fem::{
+    ExplicitConfig, ExplicitSolver, LinearElastic, LoadHistory, Prescribed, PrescribedKind,
+};
 
 const A: f64 = 4.7e-3; // inner radius, m (cartridge body)
 const B: f64 = 5.8e-3; // outer radius, m
@@ -43,7 +45,10 @@ fn constraints(rm: &RevolvedTetMesh) -> Vec<(usize, usize, f64)> {
 }
 
 fn inner_pressure(rm: &RevolvedTetMesh) -> Vec<[f64; 3]> {
-    surface_pressure_loads(&rm.mesh, P, |x| ((x[0] * x[0] + x[1] * x[1]).sqrt() - A).abs() < 1e-9).unwrap()
+    surface_pressure_loads(&rm.mesh, P, |x| {
+        ((x[0] * x[0] + x[1] * x[1]).sqrt() - A).abs() < 1e-9
+    })
+    .unwrap()
 }
 
 fn mean_inner_ur(rm: &RevolvedTetMesh, u: &[[f64; 3]]) -> f64 {
@@ -65,7 +70,10 @@ fn mean_inner_ur(rm: &RevolvedTetMesh, u: &[[f64; 3]]) -> f64 {
 #[test]
 fn lame_thick_cylinder_static() {
     let m = LinearElastic::paper_glass();
-    let rm = AxisymmetricProfile::tube(A, B, 1e-3).unwrap().tet_mesh(64, 4, 0.5e-3).unwrap();
+    let rm = AxisymmetricProfile::tube(A, B, 1e-3)
+        .unwrap()
+        .tet_mesh(64, 4, 0.5e-3)
+        .unwrap();
     let sol = solve_static(&rm.mesh, &m, &inner_pressure(&rm), &constraints(&rm)).unwrap();
     let ur = mean_inner_ur(&rm, &sol.displacement);
     let ur_exact = lame_ur(&m, A);
@@ -75,7 +83,8 @@ fn lame_thick_cylinder_static() {
     for i in 0..rm.n_theta {
         let n = rm.node_index(i, rm.n_layers, 0);
         let x = rm.mesh.nodes[n];
-        ur_out += (sol.displacement[n][0] * x[0] + sol.displacement[n][1] * x[1]) / B / rm.n_theta as f64;
+        ur_out +=
+            (sol.displacement[n][0] * x[0] + sol.displacement[n][1] * x[1]) / B / rm.n_theta as f64;
     }
     let err_uo = (ur_out - lame_ur(&m, B)).abs() / lame_ur(&m, B);
     let es = element_stresses(&rm.mesh, &m, &sol.displacement).unwrap();
@@ -88,9 +97,17 @@ fn lame_thick_cylinder_static() {
     let err_s = (mid.stress[1] - lame_hoop(r_mid)).abs() / lame_hoop(r_mid);
     println!("Lamé static: u_r(a) rel err {err_u:.2e}, u_r(b) rel err {err_uo:.2e}, σθ(mid) rel err {err_s:.2e}");
     for s in &line {
-        println!("  r = {:.4} mm  σθ = {:.4e}  exact {:.4e}", (A + s.distance) * 1e3, s.stress[1], lame_hoop(A + s.distance));
+        println!(
+            "  r = {:.4} mm  σθ = {:.4e}  exact {:.4e}",
+            (A + s.distance) * 1e3,
+            s.stress[1],
+            lame_hoop(A + s.distance)
+        );
     }
-    assert!(err_u < 0.01 && err_uo < 0.01, "radial displacement off: {err_u:e}, {err_uo:e}");
+    assert!(
+        err_u < 0.01 && err_uo < 0.01,
+        "radial displacement off: {err_u:e}, {err_uo:e}"
+    );
     assert!(err_s < 0.02, "hoop stress at mid-wall off: {err_s:e}");
 }
 
@@ -100,7 +117,10 @@ fn lame_thick_cylinder_static() {
 #[test]
 fn lame_explicit_tends_to_static() {
     let m = LinearElastic::paper_glass();
-    let rm = AxisymmetricProfile::tube(A, B, 1e-3).unwrap().tet_mesh(32, 2, 0.5e-3).unwrap();
+    let rm = AxisymmetricProfile::tube(A, B, 1e-3)
+        .unwrap()
+        .tet_mesh(32, 2, 0.5e-3)
+        .unwrap();
     let cons = constraints(&rm);
     let loads = inner_pressure(&rm);
     let stat = solve_static(&rm.mesh, &m, &loads, &cons).unwrap();
@@ -112,7 +132,11 @@ fn lame_explicit_tends_to_static() {
     let mut s = ExplicitSolver::new(&rm.mesh, cfg).unwrap();
     let pres: Vec<Prescribed> = cons
         .iter()
-        .map(|&(node, component, _)| Prescribed { node, component, kind: PrescribedKind::Displacement(0.0) })
+        .map(|&(node, component, _)| Prescribed {
+            node,
+            component,
+            kind: PrescribedKind::Displacement(0.0),
+        })
         .collect();
     s.set_prescribed(&pres, LoadHistory::Constant).unwrap();
     s.set_loads(loads, LoadHistory::Constant).unwrap();
@@ -133,9 +157,19 @@ fn lame_explicit_tends_to_static() {
         s.dt(), peak / ur_static, ur / ur_static, ur / lame_ur(&m, A), e.relative_balance_error(), e.damping_work
     );
     // Overshoot of a damped (ζ = 0.5) step response: 1 + e^{−πζ/√(1−ζ²)} = 1.163.
-    assert!((peak / ur_static - 1.163).abs() < 0.03, "overshoot {}", peak / ur_static);
-    assert!((ur / ur_static - 1.0).abs() < 1e-4, "does not tend to the static solve");
-    assert!((ur / lame_ur(&m, A) - 1.0).abs() < 0.02, "does not tend to Lamé");
+    assert!(
+        (peak / ur_static - 1.163).abs() < 0.03,
+        "overshoot {}",
+        peak / ur_static
+    );
+    assert!(
+        (ur / ur_static - 1.0).abs() < 1e-4,
+        "does not tend to the static solve"
+    );
+    assert!(
+        (ur / lame_ur(&m, A) - 1.0).abs() < 0.02,
+        "does not tend to Lamé"
+    );
 }
 
 /// Breathing (n = 0) mode of a thin ring in plane strain: ω² = E / (ρ (1 − ν²) R²)
@@ -146,13 +180,20 @@ fn lame_explicit_tends_to_static() {
 fn thin_ring_breathing_frequency() {
     let m = LinearElastic::paper_glass();
     let (ri, ro) = (9.75e-3, 10.25e-3);
-    let rm = AxisymmetricProfile::tube(ri, ro, 0.5e-3).unwrap().tet_mesh(64, 2, 0.5e-3).unwrap();
+    let rm = AxisymmetricProfile::tube(ri, ro, 0.5e-3)
+        .unwrap()
+        .tet_mesh(64, 2, 0.5e-3)
+        .unwrap();
     let r = 0.5 * (ri + ro);
     let omega = (m.youngs_modulus / (m.density * (1.0 - m.poisson_ratio.powi(2)))).sqrt() / r;
     let mut s = ExplicitSolver::new(&rm.mesh, ExplicitConfig::new(m)).unwrap();
     let mut pres = Vec::new();
     for node in 0..rm.mesh.nodes.len() {
-        pres.push(Prescribed { node, component: 2, kind: PrescribedKind::Displacement(0.0) });
+        pres.push(Prescribed {
+            node,
+            component: 2,
+            kind: PrescribedKind::Displacement(0.0),
+        });
     }
     s.set_prescribed(&pres, LoadHistory::Constant).unwrap();
     let v0: Vec<[f64; 3]> = rm
@@ -186,9 +227,16 @@ fn thin_ring_breathing_frequency() {
         prev = cur;
         s.check_energy_balance(1e-9).unwrap(); // exact identity: round-off only
     }
-    assert!(crossings.len() >= 6, "too few zero crossings: {}", crossings.len());
-    let measured = 2.0 * (crossings[crossings.len() - 1] - crossings[0]) / (crossings.len() - 1) as f64;
+    assert!(
+        crossings.len() >= 6,
+        "too few zero crossings: {}",
+        crossings.len()
+    );
+    let measured =
+        2.0 * (crossings[crossings.len() - 1] - crossings[0]) / (crossings.len() - 1) as f64;
     let err = (measured - period).abs() / period;
-    println!("breathing period measured {measured:.5e} s, closed form {period:.5e} s, rel err {err:.2e}");
+    println!(
+        "breathing period measured {measured:.5e} s, closed form {period:.5e} s, rel err {err:.2e}"
+    );
     assert!(err < 0.01, "breathing period off by {err:e}");
 }

@@ -6,7 +6,9 @@
 
 use demfem::fem::mesh::box_tet_mesh;
 use demfem::fem::stress::element_stresses;
-use demfem::fem::{ExplicitConfig, ExplicitSolver, LinearElastic, LoadHistory, Prescribed, PrescribedKind};
+use demfem::fem::{
+    ExplicitConfig, ExplicitSolver, LinearElastic, LoadHistory, Prescribed, PrescribedKind,
+};
 
 #[test]
 fn constant_velocity_impact_on_a_bar_in_uniaxial_strain() {
@@ -17,10 +19,18 @@ fn constant_velocity_impact_on_a_bar_in_uniaxial_strain() {
     let mut pres = Vec::new();
     for (i, x) in mesh.nodes.iter().enumerate() {
         for c in 0..2 {
-            pres.push(Prescribed { node: i, component: c, kind: PrescribedKind::Displacement(0.0) });
+            pres.push(Prescribed {
+                node: i,
+                component: c,
+                kind: PrescribedKind::Displacement(0.0),
+            });
         }
         if x[2] < 1e-12 {
-            pres.push(Prescribed { node: i, component: 2, kind: PrescribedKind::Velocity(v0) });
+            pres.push(Prescribed {
+                node: i,
+                component: 2,
+                kind: PrescribedKind::Velocity(v0),
+            });
         }
     }
     let mut s = ExplicitSolver::new(&mesh, ExplicitConfig::new(m)).unwrap();

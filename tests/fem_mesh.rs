@@ -27,7 +27,12 @@ fn cartridge_tet_mesh_is_exact_conforming_and_sound() {
         let m = &rm.mesh;
         // The tets fill the faceted solid exactly (planar trapezoidal facets): round-off only.
         let v_exact = faceted_volume(&p, n_theta);
-        assert!((m.volume() - v_exact).abs() < 1e-10 * v_exact, "volume {} vs {}", m.volume(), v_exact);
+        assert!(
+            (m.volume() - v_exact).abs() < 1e-10 * v_exact,
+            "volume {} vs {}",
+            m.volume(),
+            v_exact
+        );
         // Conforming: every interior face is shared by exactly two tets, so the faces seen
         // once are exactly the triangulated inner, outer and two end surfaces.
         let n_ax = rm.z_stations.len() - 1;
@@ -48,13 +53,24 @@ fn cartridge_tet_mesh_is_exact_conforming_and_sound() {
 fn sliver_and_bad_input_are_refused() {
     // Four almost coplanar points: dihedral angles near 0° and 180°.
     let mesh = TetMesh {
-        nodes: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.5, 0.5, 1e-4]],
+        nodes: vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.5, 0.5, 1e-4],
+        ],
         tets: vec![[0, 1, 2, 3]],
     };
     mesh.validate().unwrap();
-    assert!(matches!(mesh.check_quality(5.0), Err(DemfemError::InvalidParameter { .. })));
+    assert!(matches!(
+        mesh.check_quality(5.0),
+        Err(DemfemError::InvalidParameter { .. })
+    ));
     // Inverted element.
-    let mut inv = TetMesh { nodes: mesh.nodes.clone(), tets: vec![[0, 2, 1, 3]] };
+    let mut inv = TetMesh {
+        nodes: mesh.nodes.clone(),
+        tets: vec![[0, 2, 1, 3]],
+    };
     assert!(inv.validate().is_err());
     assert_eq!(inv.orient(), 1);
     inv.validate().unwrap();
@@ -82,20 +98,36 @@ fn cartridge_shell_mesh() {
     assert!((body_t - 1.1e-3).abs() < 1e-12);
     // Shoulder: mid radius 5.25 → 2.45 mm over 4 mm: cos(atan(2.8/4)).
     let cos_s = 4.0 / (4.0f64 * 4.0 + 2.8 * 2.8).sqrt();
-    assert!(s.thickness.iter().any(|&t| (t - 1.1e-3 * cos_s).abs() < 1e-12));
+    assert!(s
+        .thickness
+        .iter()
+        .any(|&t| (t - 1.1e-3 * cos_s).abs() < 1e-12));
     let solid = faceted_volume(&p, n);
     let rel = (s.volume() - solid).abs() / solid;
-    println!("shell: {} nodes, {} triangles, volume {:e} vs solid {:e} (rel {rel:.3e})", s.nodes.len(), s.triangles.len(), s.volume(), solid);
+    println!(
+        "shell: {} nodes, {} triangles, volume {:e} vs solid {:e} (rel {rel:.3e})",
+        s.nodes.len(),
+        s.triangles.len(),
+        s.volume(),
+        solid
+    );
     assert!(rel < 0.03);
 }
 
 #[test]
 fn vtk_files_are_written_atomically() {
-    let rm = AxisymmetricProfile::tube(4.7e-3, 5.8e-3, 2e-3).unwrap().tet_mesh(12, 1, 1e-3).unwrap();
+    let rm = AxisymmetricProfile::tube(4.7e-3, 5.8e-3, 2e-3)
+        .unwrap()
+        .tet_mesh(12, 1, 1e-3)
+        .unwrap();
     let m = &rm.mesh;
     let dir = std::env::temp_dir().join(format!("demfem_vtk_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let disp: Vec<f64> = m.nodes.iter().flat_map(|x| [x[0] * 1e-3, x[1] * 1e-3, 0.0]).collect();
+    let disp: Vec<f64> = m
+        .nodes
+        .iter()
+        .flat_map(|x| [x[0] * 1e-3, x[1] * 1e-3, 0.0])
+        .collect();
     let s1: Vec<f64> = (0..m.n_elements()).map(|e| e as f64).collect();
     let stress: Vec<f64> = (0..m.n_elements() * 6).map(|e| e as f64).collect();
     let mut series = PvdSeries::default();
@@ -105,26 +137,72 @@ fn vtk_files_are_written_atomically() {
             &dir.join(&name),
             &m.nodes,
             &m.tets,
-            &[DataArray { name: "displacement", n_components: 3, values: &disp }],
-            &[DataArray { name: "sigma1", n_components: 1, values: &s1 }, DataArray { name: "stress", n_components: 6, values: &stress }],
+            &[DataArray {
+                name: "displacement",
+                n_components: 3,
+                values: &disp,
+            }],
+            &[
+                DataArray {
+                    name: "sigma1",
+                    n_components: 1,
+                    values: &s1,
+                },
+                DataArray {
+                    name: "stress",
+                    n_components: 6,
+                    values: &stress,
+                },
+            ],
         )
         .unwrap();
         series.push(step as f64 * 1e-6, name);
     }
     series.write(&dir.join("tube.pvd")).unwrap();
     let text = std::fs::read_to_string(dir.join("tube_0001.vtu")).unwrap();
-    assert!(text.contains(&format!("NumberOfPoints=\"{}\" NumberOfCells=\"{}\"", m.n_nodes(), m.n_elements())));
+    assert!(text.contains(&format!(
+        "NumberOfPoints=\"{}\" NumberOfCells=\"{}\"",
+        m.n_nodes(),
+        m.n_elements()
+    )));
     assert!(text.trim_end().ends_with("</VTKFile>"));
     let pvd = std::fs::read_to_string(dir.join("tube.pvd")).unwrap();
     assert_eq!(pvd.matches("<DataSet").count(), 2);
-    assert!(std::fs::read_dir(&dir).unwrap().all(|e| !e.unwrap().file_name().to_string_lossy().ends_with(".tmp")));
+    assert!(std::fs::read_dir(&dir).unwrap().all(|e| !e
+        .unwrap()
+        .file_name()
+        .to_string_lossy()
+        .ends_with(".tmp")));
     // Wrong array length is an error, not a panic.
-    let bad = write_vtu(&dir.join("bad.vtu"), &m.nodes, &m.tets, &[DataArray { name: "x", n_components: 3, values: &s1 }], &[]);
+    let bad = write_vtu(
+        &dir.join("bad.vtu"),
+        &m.nodes,
+        &m.tets,
+        &[DataArray {
+            name: "x",
+            n_components: 3,
+            values: &s1,
+        }],
+        &[],
+    );
     assert!(matches!(bad, Err(DemfemError::ShapeMismatch { .. })));
     // Shell mid-surface as VTK triangles (cell type 5).
-    let sm = AxisymmetricProfile::default_cartridge().shell_mesh(12, 2e-3).unwrap();
+    let sm = AxisymmetricProfile::default_cartridge()
+        .shell_mesh(12, 2e-3)
+        .unwrap();
     let th: Vec<f64> = sm.thickness.clone();
-    demfem::fem::io::vtk::write_vtu_triangles(&dir.join("shell.vtu"), &sm.nodes, &sm.triangles, &[], &[DataArray { name: "thickness", n_components: 1, values: &th }]).unwrap();
+    demfem::fem::io::vtk::write_vtu_triangles(
+        &dir.join("shell.vtu"),
+        &sm.nodes,
+        &sm.triangles,
+        &[],
+        &[DataArray {
+            name: "thickness",
+            n_components: 1,
+            values: &th,
+        }],
+    )
+    .unwrap();
     let st = std::fs::read_to_string(dir.join("shell.vtu")).unwrap();
     assert_eq!(st.matches("          5\n").count(), sm.triangles.len());
     std::fs::remove_dir_all(&dir).unwrap();

@@ -48,7 +48,11 @@ fn principal_and_von_mises_closed_forms() {
 #[test]
 fn user_step_above_limit_is_refused_and_mass_scaling_is_reported() {
     let m = LinearElastic::paper_glass();
-    let mesh = AxisymmetricProfile::tube(4.7e-3, 5.8e-3, 4e-3).unwrap().tet_mesh(24, 2, 0.5e-3).unwrap().mesh;
+    let mesh = AxisymmetricProfile::tube(4.7e-3, 5.8e-3, 4e-3)
+        .unwrap()
+        .tet_mesh(24, 2, 0.5e-3)
+        .unwrap()
+        .mesh;
     let mut cfg = ExplicitConfig::new(m);
     cfg.step_bound = StepBound::ElementEigenvalue;
     let base = ExplicitSolver::new(&mesh, cfg).unwrap();
@@ -59,7 +63,10 @@ fn user_step_above_limit_is_refused_and_mass_scaling_is_reported() {
         other => panic!("expected UnstableTimeStep, got {other:?}"),
     }
     cfg.dt = Some(-1.0);
-    assert!(matches!(ExplicitSolver::new(&mesh, cfg), Err(DemfemError::InvalidParameter { .. })));
+    assert!(matches!(
+        ExplicitSolver::new(&mesh, cfg),
+        Err(DemfemError::InvalidParameter { .. })
+    ));
     // Damping lowers the limit: (2/ω)(√(1+ξ²) − ξ).
     cfg.dt = None;
     cfg.rayleigh_beta = 0.2 * limit;
@@ -78,5 +85,9 @@ fn user_step_above_limit_is_refused_and_mass_scaling_is_reported() {
     let m1: f64 = scaled.mass().iter().sum();
     assert!((m1 - m0 - scaled.added_mass()).abs() < 1e-9 * m1);
     assert!(scaled.added_mass() > 0.0);
-    println!("mass scaling to 2×dt: added {:.1} % of {:.3e} kg", 100.0 * scaled.added_mass() / m0, m0);
+    println!(
+        "mass scaling to 2×dt: added {:.1} % of {:.3e} kg",
+        100.0 * scaled.added_mass() / m0,
+        m0
+    );
 }

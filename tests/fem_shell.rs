@@ -34,7 +34,11 @@ fn grid(n: usize, m: usize, h: f64, f: impl Fn(f64, f64) -> [f64; 3]) -> TriMesh
         }
     }
     let thickness = vec![h; triangles.len()];
-    TriMesh { nodes, triangles, thickness }
+    TriMesh {
+        nodes,
+        triangles,
+        thickness,
+    }
 }
 
 /// The DKT curvatures of a quadratic deflection w = ½ a x² + ½ b y² + c x y + d x + e y + g
@@ -50,9 +54,19 @@ fn dkt_and_membrane_patch_test_single_element() {
         u[3 * n + 1] = b * y + c * x + e; // θx = ∂w/∂y
         u[3 * n + 2] = -(a * x + c * y + d); // θy = −∂w/∂x
     }
-    for (xi, eta) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (0.2, 0.3), (0.5, 0.5), (1.0 / 3.0, 1.0 / 3.0)] {
+    for (xi, eta) in [
+        (0.0, 0.0),
+        (1.0, 0.0),
+        (0.0, 1.0),
+        (0.2, 0.3),
+        (0.5, 0.5),
+        (1.0 / 3.0, 1.0 / 3.0),
+    ] {
         let k = el.dkt_b(xi, eta) * u;
-        assert!((k[0] + a).abs() < 1e-12 && (k[1] + b).abs() < 1e-12 && (k[2] + 2.0 * c).abs() < 1e-12, "κ = {k:?} at ({xi}, {eta})");
+        assert!(
+            (k[0] + a).abs() < 1e-12 && (k[1] + b).abs() < 1e-12 && (k[2] + 2.0 * c).abs() < 1e-12,
+            "κ = {k:?} at ({xi}, {eta})"
+        );
     }
     // Membrane: u = ε_xx x + γ/2 y, v = ε_yy y + γ/2 x.
     let mut um = nalgebra::SVector::<f64, 6>::zeros();
@@ -62,7 +76,11 @@ fn dkt_and_membrane_patch_test_single_element() {
         um[2 * n + 1] = -5e-4 * y + 2e-4 * x;
     }
     let em = el.membrane_b() * um;
-    assert!((em[0] - 1e-3).abs() < 1e-15 && (em[1] + 5e-4).abs() < 1e-15 && (em[2] - 4e-4).abs() < 1e-15);
+    assert!(
+        (em[0] - 1e-3).abs() < 1e-15
+            && (em[1] + 5e-4).abs() < 1e-15
+            && (em[2] - 4e-4).abs() < 1e-15
+    );
 }
 
 /// Whole-mesh patch test on a distorted plate lying in a tilted plane: with boundary dofs
@@ -77,13 +95,20 @@ fn shell_mesh_patch_test_tilted_plate() {
     let n = 6;
     let mut mesh = grid(n, n, 0.01, |s, t| {
         let (x, y) = (s, t);
-        [x * e1[0] + y * e2[0], x * e1[1] + y * e2[1], x * e1[2] + y * e2[2]]
+        [
+            x * e1[0] + y * e2[0],
+            x * e1[1] + y * e2[1],
+            x * e1[2] + y * e2[2],
+        ]
     });
     // Distort interior nodes in the plate plane.
     for j in 1..n {
         for i in 1..n {
             let k = j * (n + 1) + i;
-            let (ds, dt) = (0.02 * (((i * 7 + j * 3) % 5) as f64 - 2.0), 0.02 * (((i * 3 + j * 5) % 5) as f64 - 2.0));
+            let (ds, dt) = (
+                0.02 * (((i * 7 + j * 3) % 5) as f64 - 2.0),
+                0.02 * (((i * 3 + j * 5) % 5) as f64 - 2.0),
+            );
             for c in 0..3 {
                 mesh.nodes[k][c] += ds * e1[c] + dt * e2[c];
             }
@@ -121,7 +146,12 @@ fn shell_mesh_patch_test_tilted_plate() {
         for k in 0..5 {
             // Drilling rotation θ·e3 is not part of the field; translations and in-plane
             // rotations must match to round-off (scale 1e-3).
-            assert!((x[6 * i + k] - d[k]).abs() < 1e-10, "node {i} dof {k}: {} vs {}", x[6 * i + k], d[k]);
+            assert!(
+                (x[6 * i + k] - d[k]).abs() < 1e-10,
+                "node {i} dof {k}: {} vs {}",
+                x[6 * i + k],
+                d[k]
+            );
         }
     }
 }
@@ -217,7 +247,11 @@ fn pinched_hemisphere_with_hole() {
     for n in [8, 16, 24, 32] {
         let mesh = grid(n, n, t, |s, tt| {
             let (az, lat) = (s * 0.5 * PI, tt * 72f64.to_radians());
-            [r * lat.cos() * az.cos(), r * lat.cos() * az.sin(), r * lat.sin()]
+            [
+                r * lat.cos() * az.cos(),
+                r * lat.cos() * az.sin(),
+                r * lat.sin(),
+            ]
         });
         let model = ShellModel::new(mesh, mat).unwrap();
         let mut f = vec![0.0; model.n_dofs()];
@@ -237,7 +271,10 @@ fn pinched_hemisphere_with_hole() {
         let x = model.solve_static(&f, &fixed).unwrap();
         last = x[0] / 0.094;
         let other = -x[6 * n + 1] / 0.094;
-        println!("  {n:2}  {:5}  {last:.4} (other load point {other:.4})", model.n_dofs());
+        println!(
+            "  {n:2}  {:5}  {last:.4} (other load point {other:.4})",
+            model.n_dofs()
+        );
     }
     assert!((last - 1.0).abs() < 0.03, "pinched hemisphere off: {last}");
 }
@@ -274,14 +311,21 @@ fn explicit_shell_cantilever_first_frequency() {
     let ei = mat.youngs_modulus * b * h.powi(3) / 12.0;
     // Static tip deflection against P L³/(3EI), as a check of the initial state (1 %).
     let w_static = 1.0 * l.powi(3) / (3.0 * ei);
-    assert!((u0[tip] / w_static - 1.0).abs() < 0.01, "static tip {} vs {w_static}", u0[tip]);
+    assert!(
+        (u0[tip] / w_static - 1.0).abs() < 0.01,
+        "static tip {} vs {w_static}",
+        u0[tip]
+    );
     let omega = 1.875_104_07f64.powi(2) * (ei / (mat.density * b * h * l.powi(4))).sqrt();
     let period = 2.0 * PI / omega;
     let run = |threads: usize| {
         let mut s = ShellExplicit::new(&model, &fixed, None).unwrap();
         s.set_initial_displacement(&u0).unwrap();
         let n = (2.3 * period / s.dt()).ceil() as u64;
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
         let mut crossings = Vec::new();
         let mut prev = u0[tip];
         let mut max_err: f64 = 0.0;
@@ -295,15 +339,27 @@ fn explicit_shell_cantilever_first_frequency() {
             prev = cur;
             max_err = max_err.max(s.relative_balance_error());
         }
-        (crossings, s.displacement().to_vec(), max_err, s.dt(), s.dt_limit())
+        (
+            crossings,
+            s.displacement().to_vec(),
+            max_err,
+            s.dt(),
+            s.dt_limit(),
+        )
     };
     let (c1, u1, err1, dt, dt_lim) = run(1);
     let (_, u2, _, _, _) = run(2);
-    assert!(u1.iter().zip(&u2).all(|(a, b)| a.to_bits() == b.to_bits()), "1 and 2 threads differ");
+    assert!(
+        u1.iter().zip(&u2).all(|(a, b)| a.to_bits() == b.to_bits()),
+        "1 and 2 threads differ"
+    );
     assert!(c1.len() >= 4);
     let measured = 2.0 * (c1[c1.len() - 1] - c1[0]) / (c1.len() - 1) as f64;
     let rel = (measured - period).abs() / period;
     println!("shell cantilever: dt {dt:.3e} (limit {dt_lim:.3e}), period {measured:.5e} vs {period:.5e} (rel {rel:.2e}), energy balance {err1:.1e}");
     assert!(rel < 0.02);
-    assert!(err1 < 1e-9, "discrete energy balance is exact up to round-off: {err1:e}");
+    assert!(
+        err1 < 1e-9,
+        "discrete energy balance is exact up to round-off: {err1:e}"
+    );
 }

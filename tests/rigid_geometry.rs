@@ -219,6 +219,59 @@ fn exact_cartridges_side_by_side_and_bead_against_exact() {
 }
 
 #[test]
+fn skew_exact_cartridges_touch_only_where_their_sides_cross() {
+    // two cylinder bodies side by side along x, b's axis tilted by θ about x: the sides of
+    // two skew cylinders overlap by r_a + r_b − d (d the distance between the axes, here the
+    // x offset) only around the point where the axes pass closest (here z = 0 of a's axis).
+    // Parry's clipped side generators also report their ends, up to 30 mm away, with that
+    // full overlap; those must not become contacts (they did before the fix).
+    let (exact, _) = cartridge_exact();
+    let overlap = 1.5e-5;
+    let r = 5.8e-3;
+    for tilt in [1.0_f64, 7.0, 20.0, 40.0] {
+        let b = BodyPose {
+            position: Vector3::new(2.0 * r - overlap, 0.0, 0.0),
+            orientation: UnitQuaternion::from_axis_angle(&Vector3::x_axis(), tilt.to_radians()),
+        };
+        let mut out = Vec::new();
+        let mut cache = ExactContactCache::default();
+        exact_exact_contacts(
+            &exact,
+            &upright(0.0, 0.0, 0.0),
+            &exact,
+            &b,
+            &mut cache,
+            &mut out,
+        )
+        .unwrap();
+        let deepest = out
+            .iter()
+            .max_by(|x, y| x.overlap.total_cmp(&y.overlap))
+            .unwrap();
+        assert!((deepest.overlap - overlap).abs() < 1e-9, "{tilt}°: {out:?}");
+        assert!(
+            (deepest.normal - Vector3::x()).norm() < 1e-3,
+            "{tilt}°: {out:?}"
+        );
+        // Hertz contact ellipse of two crossed cylinders: semi-axes ~ √(R δ) ≈ 0.3 mm; away
+        // from the crossing the sides part as (s sin θ)² / 4R, so at 1° contact may extend
+        // along the line to where that reaches δ (s = √(4 R δ) / sin θ ≈ 34 mm), at 7° to 5 mm
+        let reach = (4.0 * r * overlap).sqrt() / tilt.to_radians().sin();
+        for c in &out {
+            let s = c.point.z.hypot(c.point.y);
+            assert!(
+                s < reach.max(0.3e-3) + 1e-6,
+                "{tilt}°: contact {} mm from the crossing (reach {} mm): {c:?}",
+                s * 1e3,
+                reach * 1e3
+            );
+            assert!(c.overlap > 0.0 && c.overlap <= overlap + 1e-9);
+        }
+        println!("{tilt}°: {} contact point(s)", out.len());
+    }
+}
+
+#[test]
 fn time_step_above_the_limit_is_refused() {
     let (shape, mass) = cartridge("clump");
     let mut scene = RigidScene::new(RigidSceneConfig::default()).unwrap();

@@ -262,7 +262,13 @@ fn exact_cartridge_bouncing_off_a_wall_twice() {
     let (mut scene, id) = scene("exact", config);
     let z0 = 0.04; // the bottom 9 mm above the floor: out of the bounding sphere's reach
     scene
-        .add_body(id, Vector3::new(0.0, 0.0, z0), UnitQuaternion::identity(), Vector3::zeros(), Vector3::zeros())
+        .add_body(
+            id,
+            Vector3::new(0.0, 0.0, z0),
+            UnitQuaternion::identity(),
+            Vector3::zeros(),
+            Vector3::zeros(),
+        )
         .unwrap();
     let h = z0 - com_height();
     let fall = (2.0 * h / g).sqrt();
@@ -272,6 +278,9 @@ fn exact_cartridge_bouncing_off_a_wall_twice() {
     assert_eq!(onsets.len(), 2, "{onsets:?}");
     let v_hit = (2.0 * g * h).sqrt();
     for o in onsets {
-        assert!((o.normal_speed / v_hit - 1.0).abs() < 0.01, "{o:?} vs {v_hit}");
+        assert!(
+            (o.normal_speed / v_hit - 1.0).abs() < 0.01,
+            "{o:?} vs {v_hit}"
+        );
     }
 }

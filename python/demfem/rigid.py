@@ -26,6 +26,7 @@ from demfem.cartridge import Cartridge
 from demfem.dem import Progress, material, scene_walls
 from demfem.dem import run as _run
 from demfem.errors import InvalidParameterError
+from demfem.scenes.table import cartridge_sites
 
 __all__ = [
     "RigidSimulation",
@@ -84,6 +85,13 @@ def from_scene(
     that spheres and full shapes carry the same mass. ``dt`` (s) defaults to the stable limit
     of the stiffest contact at ``expected_max_speed`` (m/s); a larger one is refused.
     Bodies whose centre of mass crosses the scene's removal plane are removed.
+
+    Mixed tables (``cartridge_fraction < 1``, see
+    :class:`demfem.scenes.table.AccumulationTable`): the sites that
+    :func:`demfem.scenes.table.cartridge_sites` does not pick keep their equivalent sphere
+    (radius and mass of the scene, resting ``lift`` above the belt), as a one-bead body of the
+    same engine, so spheres and cartridges touch each other through the same contact laws.
+    ``sim.is_sphere()`` tells them apart; their tilt angles are NaN.
     """
     if particle is None:
         particle = str(scene.parameters.get("particle", "sphere"))
@@ -108,7 +116,11 @@ def from_scene(
                      friction=pm["friction"], restitution=pm["restitution"])]
     walls = scene_walls(scene, lambda name: 0)
     positions = np.array(scene.positions, float, copy=True)
-    positions[:, 2] = float(c.center_of_mass[2]) + lift
+    fraction = float(scene.parameters.get("cartridge_fraction", 1.0))
+    is_cartridge = cartridge_sites(len(positions), fraction)
+    radii = np.asarray(scene.radii, float)
+    positions[:, 2] = np.where(is_cartridge, float(c.center_of_mass[2]), radii) + lift
+    spheres = None if bool(is_cartridge.all()) else np.ascontiguousarray(~is_cartridge)
     removal_plane = None
     if scene.removal is not None:
         p = [float(x) for x in scene.removal["point"]]
@@ -120,7 +132,8 @@ def from_scene(
         shape_dict(particle, c, n_beads), mats[0], walls, list(scene.effects),
         gravity=(float(g[0]), float(g[1]), float(g[2])), dt=dt,
         expected_max_speed=expected_max_speed, removal_plane=removal_plane,
-        record_onsets=record_onsets,
+        record_onsets=record_onsets, spheres=spheres,
+        sphere_radius=None if spheres is None else float(radii[0]),
     )
 
 

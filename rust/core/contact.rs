@@ -15,10 +15,18 @@ pub fn effective_modulus(e1: f64, nu1: f64, e2: f64, nu2: f64) -> Result<f64> {
     check_positive("E1", e1)?;
     check_open("nu1", nu1, -1.0, 0.5)?;
     if !(e2 > 0.0) || e2.is_nan() {
-        return Err(DemfemError::invalid("E2", e2, "> 0 (inf for a rigid partner)"));
+        return Err(DemfemError::invalid(
+            "E2",
+            e2,
+            "> 0 (inf for a rigid partner)",
+        ));
     }
     check_open("nu2", nu2, -1.0, 0.5)?;
-    let c2 = if e2.is_infinite() { 0.0 } else { (1.0 - nu2 * nu2) / e2 };
+    let c2 = if e2.is_infinite() {
+        0.0
+    } else {
+        (1.0 - nu2 * nu2) / e2
+    };
     Ok(1.0 / ((1.0 - nu1 * nu1) / e1 + c2))
 }
 
@@ -28,16 +36,28 @@ pub fn effective_radius(r1: f64, r2: f64) -> Result<f64> {
     if !(r2 > 0.0) || r2.is_nan() {
         return Err(DemfemError::invalid("R2", r2, "> 0 (inf for a plane)"));
     }
-    Ok(if r2.is_infinite() { r1 } else { 1.0 / (1.0 / r1 + 1.0 / r2) })
+    Ok(if r2.is_infinite() {
+        r1
+    } else {
+        1.0 / (1.0 / r1 + 1.0 / r2)
+    })
 }
 
 /// Effective mass m* (eq. 9), kg. `m2 = inf` models an immovable partner.
 pub fn effective_mass(m1: f64, m2: f64) -> Result<f64> {
     check_positive("m1", m1)?;
     if !(m2 > 0.0) || m2.is_nan() {
-        return Err(DemfemError::invalid("m2", m2, "> 0 (inf for an immovable partner)"));
+        return Err(DemfemError::invalid(
+            "m2",
+            m2,
+            "> 0 (inf for an immovable partner)",
+        ));
     }
-    Ok(if m2.is_infinite() { m1 } else { 1.0 / (1.0 / m1 + 1.0 / m2) })
+    Ok(if m2.is_infinite() {
+        m1
+    } else {
+        1.0 / (1.0 / m1 + 1.0 / m2)
+    })
 }
 
 /// Hertz stiffness k_H = 4/3 √R* E* (eq. 2), N/m^{3/2}.
@@ -277,10 +297,20 @@ pub fn tsuji_restitution(zeta: f64, clamp: ForceClamp) -> f64 {
         if x > 0.0 && x < 1e-13 && v < 0.0 {
             return -v;
         }
-        let h = if v.abs() > 0.0 { (0.02 * x / v.abs()).clamp(1e-13, h_max) } else { h_max };
+        let h = if v.abs() > 0.0 {
+            (0.02 * x / v.abs()).clamp(1e-13, h_max)
+        } else {
+            h_max
+        };
         let (k1x, k1v) = (v, accel(x, v));
-        let (k2x, k2v) = (v + 0.5 * h * k1v, accel(x + 0.5 * h * k1x, v + 0.5 * h * k1v));
-        let (k3x, k3v) = (v + 0.5 * h * k2v, accel(x + 0.5 * h * k2x, v + 0.5 * h * k2v));
+        let (k2x, k2v) = (
+            v + 0.5 * h * k1v,
+            accel(x + 0.5 * h * k1x, v + 0.5 * h * k1v),
+        );
+        let (k3x, k3v) = (
+            v + 0.5 * h * k2v,
+            accel(x + 0.5 * h * k2x, v + 0.5 * h * k2v),
+        );
         let (k4x, k4v) = (v + h * k3v, accel(x + h * k3x, v + h * k3v));
         let xn = x + h / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x);
         let vn = v + h / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
@@ -293,7 +323,11 @@ pub fn tsuji_restitution(zeta: f64, clamp: ForceClamp) -> f64 {
             if f <= 0.0 {
                 // the force vanished: from here on the bodies drift apart at constant speed
                 let f_prev = x * x.sqrt() + zeta * x.sqrt().sqrt() * v;
-                let frac = if f_prev > 0.0 { f_prev / (f_prev - f) } else { 1.0 };
+                let frac = if f_prev > 0.0 {
+                    f_prev / (f_prev - f)
+                } else {
+                    1.0
+                };
                 return -(v + frac * (vn - v));
             }
         }
@@ -311,7 +345,11 @@ pub fn tsuji_restitution(zeta: f64, clamp: ForceClamp) -> f64 {
 /// [`tsuji_restitution`]); e in (0, 1], ζ = 0 for e = 1.
 pub fn tsuji_damping_for_restitution(e: f64, clamp: ForceClamp) -> Result<f64> {
     if !(e.is_finite() && e > 0.0 && e <= 1.0) {
-        return Err(DemfemError::invalid("restitution", e, "finite and in (0, 1]"));
+        return Err(DemfemError::invalid(
+            "restitution",
+            e,
+            "finite and in (0, 1]",
+        ));
     }
     if e == 1.0 {
         return Ok(0.0);
@@ -320,7 +358,11 @@ pub fn tsuji_damping_for_restitution(e: f64, clamp: ForceClamp) -> Result<f64> {
     while tsuji_restitution(hi, clamp) > e {
         hi *= 2.0;
         if hi > 1e6 {
-            return Err(DemfemError::invalid("restitution", e, "reachable by Tsuji damping"));
+            return Err(DemfemError::invalid(
+                "restitution",
+                e,
+                "reachable by Tsuji damping",
+            ));
         }
     }
     for _ in 0..60 {

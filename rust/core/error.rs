@@ -77,7 +77,11 @@ pub fn check_open(field: &str, value: f64, lo: f64, hi: f64) -> Result<f64> {
     if value.is_finite() && value > lo && value < hi {
         Ok(value)
     } else {
-        Err(DemfemError::invalid(field, value, &format!("finite and in ({lo}, {hi})")))
+        Err(DemfemError::invalid(
+            field,
+            value,
+            &format!("finite and in ({lo}, {hi})"),
+        ))
     }
 }
 

@@ -127,3 +127,96 @@ def test_belt_friction_topples_a_cartridge_only_above_r_over_zc(particle):
     low, high = tilt[0.7 * critical], tilt[1.5 * critical]
     assert low < 2.0, tilt
     assert high > 45.0, tilt
+
+
+@pytest.mark.parametrize("particle,fraction", [("cylinder", 0.5), ("clump", 0.25),
+                                               ("cylinder", 0.0)])
+def test_mixed_table_builds_counts_and_runs(particle, fraction):
+    from demfem.scenes.table import cartridge_sites
+
+    table = _small_table(particle=particle, cartridge_fraction=fraction)
+    description = table.build()
+    n = description.n_particles
+    sim = rigid.from_scene(description)
+    is_sphere = sim.is_sphere()
+    # exactly round(n f) cartridges, at the sites cartridge_sites picks
+    assert int((~is_sphere).sum()) == round(n * fraction)
+    np.testing.assert_array_equal(~is_sphere, cartridge_sites(n, fraction))
+    # spheres rest on the belt at their radius, cartridges at their centre of mass
+    c = Cartridge()
+    z = sim.positions()[:, 2]
+    np.testing.assert_allclose(z[is_sphere], table.sphere_radius + 1e-6, atol=1e-12)
+    np.testing.assert_allclose(z[~is_sphere], c.center_of_mass[2] + 1e-6, atol=1e-12)
+    assert sim.body_mass == pytest.approx(table.sphere_mass, rel=1e-6)
+    # nothing overlaps at the start: the first force evaluation finds only belt contacts
+    sim.step(1)
+    assert int(sim.coordination().sum()) == 0
+    assert sim.max_overlap() < 1e-5
+    sim.step(400)
+    for state in (sim.positions(), sim.velocities(), sim.angular_velocities(),
+                  sim.orientations()):
+        assert np.all(np.isfinite(state))
+    # spheres have no axis; cartridges keep standing over a few hundred steps
+    tilt = sim.tilt_angles()
+    assert np.all(np.isnan(tilt[is_sphere])) and np.all(np.isfinite(tilt[~is_sphere]))
+    if (~is_sphere).any():
+        assert math.degrees(np.max(tilt[~is_sphere])) < 1.0
+    assert np.max(np.linalg.norm(sim.velocities(), axis=1)) < 0.3
+
+
+def test_sphere_meets_cartridge_with_momentum_conserved():
+    # a sphere (one-bead body) hits a lying exact cartridge side-on above its centre of mass,
+    # no gravity, no walls: momentum is conserved to round-off, velocities as for two spheres
+    c = Cartridge()
+    r = c.equivalent_sphere().radius
+    lying = np.array([[math.cos(math.pi / 4), math.sin(math.pi / 4), 0.0, 0.0],
+                      [1.0, 0.0, 0.0, 0.0]])
+    x = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 0.5 * c.body_outer_diameter + r + 1e-5]])
+    v = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, -0.2]])
+    sim = rigid.RigidSimulation(x, lying, rigid.shape_dict("cylinder"), GLASS, [],
+                                ["friction", "rotation", "damping"], velocities=v,
+                                spheres=np.array([False, True]), sphere_radius=r)
+    m = sim.body_mass
+    e0 = sim.kinetic_energy()
+    p0 = m * v.sum(axis=0)
+    sim.run_until(2e-3)
+    p1 = m * sim.velocities().sum(axis=0)
+    np.testing.assert_allclose(p1, p0, atol=1e-15)
+    # a central hit of equal masses (the equivalent sphere carries the cartridge's mass) with
+    # restitution e = 0.5: v_sphere = (1 - e)/2 v0 = -0.05 m/s, v_cartridge = (1 + e)/2 v0 =
+    # -0.15 m/s, kinetic energy (1 + e^2)/2 = 0.625 of the start
+    assert sim.velocities()[1, 2] == pytest.approx(-0.05, abs=0.01)
+    assert sim.velocities()[0, 2] == pytest.approx(-0.15, abs=0.01)
+    assert sim.kinetic_energy() / e0 == pytest.approx(0.625, abs=0.03)
+
+
+def test_mixed_table_validation(tmp_path: Path):
+    with pytest.raises(InvalidParameterError, match=r"cartridge_fraction = 1\.5.*\[0, 1\]"):
+        _small_table(particle="clump", cartridge_fraction=1.5)
+    with pytest.raises(InvalidParameterError, match=r"cartridge_fraction = -0\.1"):
+        _small_table(particle="clump", cartridge_fraction=-0.1)
+    with pytest.raises(InvalidParameterError, match="cartridge_fraction = 0.5 with particle = 'sphere'"):
+        _small_table(cartridge_fraction=0.5)
+    with pytest.raises(InvalidParameterError, match="cartridge_fraction"):
+        _small_table(particle="clump", cartridge_fraction="half")
+    table = _small_table(particle="cylinder", cartridge_fraction=0.3)
+    path = table.to_toml(tmp_path / "mixed.toml")
+    assert "cartridge_fraction = 0.3" in path.read_text()
+    assert AccumulationTable.from_toml(path) == table
+    x = np.zeros((2, 3))
+    with pytest.raises(InvalidParameterError, match="sphere_radius"):
+        rigid.RigidSimulation(x, rigid.upright(2), rigid.shape_dict("cylinder"), GLASS, [BELT],
+                              EFFECTS, spheres=np.array([True, False]))
+    with pytest.raises(ShapeError, match="spheres"):
+        rigid.RigidSimulation(x, rigid.upright(2), rigid.shape_dict("cylinder"), GLASS, [BELT],
+                              EFFECTS, spheres=np.array([True]), sphere_radius=8e-3)
+
+
+def test_cartridge_sites_rule():
+    from demfem.scenes.table import cartridge_sites
+
+    mask = cartridge_sites(10, 0.3)
+    np.testing.assert_array_equal(np.flatnonzero(mask), [3, 6, 9])
+    assert cartridge_sites(7, 1.0).all() and not cartridge_sites(7, 0.0).any()
+    with pytest.raises(InvalidParameterError, match="cartridge_fraction"):
+        cartridge_sites(5, 2.0)

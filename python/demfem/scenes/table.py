@@ -96,6 +96,7 @@ __all__ = [
     "SceneDescription",
     "Tag",
     "TAG_NAMES",
+    "cartridge_sites",
     "wall_displacement",
     "wall_velocity",
 ]
@@ -383,6 +384,13 @@ class AccumulationTable:
             :func:`demfem.rigid.from_scene`. Full shapes need ``wall_height`` at least the
             cartridge length (an upright cartridge must not lean over the walls) and cannot
             run ``planar``.
+        cartridge_fraction: mixed tables: the fraction of start sites, in [0, 1], that hold
+            a cartridge of the shape named by ``particle`` (``"clump"`` or ``"cylinder"``); the
+            other sites hold equivalent spheres, and both run together in the rigid engine
+            (:func:`demfem.rigid.from_scene`). Which sites: :func:`cartridge_sites` — exactly
+            round(n f) of them, spread evenly over the site order (deterministic, no seed).
+            1 (the default) fills every site with ``particle``; with ``particle = "sphere"``
+            it must stay 1.
     """
 
     n_spheres: int = 840
@@ -409,6 +417,7 @@ class AccumulationTable:
     refeed: bool = False
     packing_gap: float = 0.01
     particle: str = "sphere"
+    cartridge_fraction: float = 1.0
 
     # ---- validation ------------------------------------------------------------------------
 
@@ -485,6 +494,13 @@ class AccumulationTable:
         if self.particle not in PARTICLES:
             raise InvalidParameterError(
                 f"invalid particle = {self.particle!r}: must be one of {PARTICLES}")
+        check_range("cartridge_fraction", self.cartridge_fraction, 0.0, 1.0, lo_open=False,
+                    hi_open=False)
+        if self.particle == "sphere" and self.cartridge_fraction != 1.0:
+            raise InvalidParameterError(
+                f"invalid cartridge_fraction = {self.cartridge_fraction!r} with particle = "
+                "'sphere': the fraction of sites holding cartridges needs particle = 'clump' "
+                "or 'cylinder' (the cartridge shape); with spheres it must be 1")
         if self.particle != "sphere":
             length = Cartridge().length
             _explained(check_range, "wall_height", self.wall_height, length, inf,
@@ -868,7 +884,23 @@ _UNITS: dict[str, str] = {
     "refeed": "re-insert removed spheres upstream",
     "packing_gap": "gap between start neighbours, fraction of the diameter",
     "particle": "sphere, clump (632-bead cartridge) or cylinder (exact cartridge)",
+    "cartridge_fraction": "fraction of sites with a cartridge of shape particle, in [0, 1]; "
+                          "the rest are equivalent spheres",
 }
+
+
+def cartridge_sites(n: int, fraction: float) -> np.ndarray:
+    """Which of ``n`` start sites hold a cartridge in a table with ``cartridge_fraction =
+    fraction``: a boolean mask with exactly ``m = round(n * fraction)`` True entries, site
+    ``k`` (in the order of :meth:`AccumulationTable.start_positions`) being a cartridge when
+    ``floor((k + 1) m / n) > floor(k m / n)`` — the cartridges spread evenly along the site
+    order, the same on every run and machine."""
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 0:
+        raise InvalidParameterError(f"invalid n = {n!r}: must be a whole number >= 0")
+    check_range("cartridge_fraction", fraction, 0.0, 1.0, lo_open=False, hi_open=False)
+    m = int(round(n * float(fraction)))
+    k = np.arange(n, dtype=np.int64)
+    return ((k + 1) * m) // max(n, 1) > (k * m) // max(n, 1)
 
 
 def _explained(check, name: str, value: Any, *args: Any, why: str, **kwargs: Any) -> float:

@@ -719,8 +719,7 @@ impl DemSimulation {
     }
 }
 
-impl DemSimulation {
-}
+impl DemSimulation {}
 
 /// The `partner` (index) and `partner_is_wall` columns of an onset or contact table.
 fn set_partner_columns(

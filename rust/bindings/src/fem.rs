@@ -9,7 +9,10 @@ use pyo3::types::PyDict;
 
 use demfem::fem::io::vtk::{write_vtu, DataArray};
 use demfem::fem::stable_step::StepBound;
-use demfem::fem::{stress, AxisymmetricProfile, ExplicitConfig, ExplicitSolver, LinearElastic, LoadHistory, Prescribed, PrescribedKind, TetMesh};
+use demfem::fem::{
+    stress, AxisymmetricProfile, ExplicitConfig, ExplicitSolver, LinearElastic, LoadHistory,
+    Prescribed, PrescribedKind, TetMesh,
+};
 use demfem::DemfemError;
 
 use crate::PyDemfemError;
@@ -17,22 +20,35 @@ use crate::PyDemfemError;
 type Nodes<'py> = Bound<'py, PyArray2<f64>>;
 
 fn shape_err(field: &str, detail: String) -> PyErr {
-    PyDemfemError::from(DemfemError::ShapeMismatch { field: field.into(), detail }).into()
+    PyDemfemError::from(DemfemError::ShapeMismatch {
+        field: field.into(),
+        detail,
+    })
+    .into()
 }
 
 fn rows3(a: &PyReadonlyArray2<'_, f64>, field: &str) -> PyResult<Vec<[f64; 3]>> {
     let v = a.as_array();
     if v.ncols() != 3 {
-        return Err(shape_err(field, format!("expected shape (n, 3), got {:?}", v.shape())));
+        return Err(shape_err(
+            field,
+            format!("expected shape (n, 3), got {:?}", v.shape()),
+        ));
     }
     Ok(v.rows().into_iter().map(|r| [r[0], r[1], r[2]]).collect())
 }
 
-fn to_mesh(nodes: &PyReadonlyArray2<'_, f64>, tets: &PyReadonlyArray2<'_, i64>) -> PyResult<TetMesh> {
+fn to_mesh(
+    nodes: &PyReadonlyArray2<'_, f64>,
+    tets: &PyReadonlyArray2<'_, i64>,
+) -> PyResult<TetMesh> {
     let nodes = rows3(nodes, "nodes")?;
     let t = tets.as_array();
     if t.ncols() != 4 {
-        return Err(shape_err("tets", format!("expected shape (n, 4), got {:?}", t.shape())));
+        return Err(shape_err(
+            "tets",
+            format!("expected shape (n, 4), got {:?}", t.shape()),
+        ));
     }
     let mut out = Vec::with_capacity(t.nrows());
     for r in t.rows() {
@@ -50,24 +66,39 @@ fn to_mesh(nodes: &PyReadonlyArray2<'_, f64>, tets: &PyReadonlyArray2<'_, i64>) 
 
 fn arr3<'py>(py: Python<'py>, v: &[[f64; 3]]) -> PyResult<Nodes<'py>> {
     let flat: Vec<f64> = v.iter().flatten().cloned().collect();
-    let a = Array2::from_shape_vec((v.len(), 3), flat).map_err(|e| shape_err("array", e.to_string()))?;
+    let a = Array2::from_shape_vec((v.len(), 3), flat)
+        .map_err(|e| shape_err("array", e.to_string()))?;
     Ok(a.into_pyarray(py))
 }
 
 fn arr6<'py>(py: Python<'py>, v: &[[f64; 6]]) -> PyResult<Nodes<'py>> {
     let flat: Vec<f64> = v.iter().flatten().cloned().collect();
-    let a = Array2::from_shape_vec((v.len(), 6), flat).map_err(|e| shape_err("array", e.to_string()))?;
+    let a = Array2::from_shape_vec((v.len(), 6), flat)
+        .map_err(|e| shape_err("array", e.to_string()))?;
     Ok(a.into_pyarray(py))
 }
 
-fn idx_arr<'py, const K: usize>(py: Python<'py>, v: &[[usize; K]]) -> PyResult<Bound<'py, PyArray2<i64>>> {
+fn idx_arr<'py, const K: usize>(
+    py: Python<'py>,
+    v: &[[usize; K]],
+) -> PyResult<Bound<'py, PyArray2<i64>>> {
     let flat: Vec<i64> = v.iter().flatten().map(|&i| i as i64).collect();
-    let a = Array2::from_shape_vec((v.len(), K), flat).map_err(|e| shape_err("array", e.to_string()))?;
+    let a = Array2::from_shape_vec((v.len(), K), flat)
+        .map_err(|e| shape_err("array", e.to_string()))?;
     Ok(a.into_pyarray(py))
 }
 
-fn profile(z: PyReadonlyArray1<'_, f64>, r_in: PyReadonlyArray1<'_, f64>, r_out: PyReadonlyArray1<'_, f64>) -> PyResult<AxisymmetricProfile> {
-    Ok(AxisymmetricProfile::new(z.as_array().to_vec(), r_in.as_array().to_vec(), r_out.as_array().to_vec()).map_err(PyDemfemError::from)?)
+fn profile(
+    z: PyReadonlyArray1<'_, f64>,
+    r_in: PyReadonlyArray1<'_, f64>,
+    r_out: PyReadonlyArray1<'_, f64>,
+) -> PyResult<AxisymmetricProfile> {
+    Ok(AxisymmetricProfile::new(
+        z.as_array().to_vec(),
+        r_in.as_array().to_vec(),
+        r_out.as_array().to_vec(),
+    )
+    .map_err(PyDemfemError::from)?)
 }
 
 /// Revolved linear-tetrahedron mesh of an axisymmetric body (stations z, radii r_in,
@@ -86,8 +117,13 @@ fn fem_tet_mesh<'py>(
     min_dihedral_deg: f64,
 ) -> PyResult<(Nodes<'py>, Bound<'py, PyArray2<i64>>, Bound<'py, PyDict>)> {
     let p = profile(z, r_in, r_out)?;
-    let rm = py.detach(|| p.tet_mesh(n_theta, n_layers, target_size)).map_err(PyDemfemError::from)?;
-    let q = rm.mesh.check_quality(min_dihedral_deg).map_err(PyDemfemError::from)?;
+    let rm = py
+        .detach(|| p.tet_mesh(n_theta, n_layers, target_size))
+        .map_err(PyDemfemError::from)?;
+    let q = rm
+        .mesh
+        .check_quality(min_dihedral_deg)
+        .map_err(PyDemfemError::from)?;
     let d = PyDict::new(py);
     d.set_item("min_dihedral_deg", q.min_dihedral_deg)?;
     d.set_item("max_dihedral_deg", q.max_dihedral_deg)?;
@@ -109,24 +145,47 @@ fn fem_shell_mesh<'py>(
     r_out: PyReadonlyArray1<'py, f64>,
     n_theta: usize,
     target_size: f64,
-) -> PyResult<(Nodes<'py>, Bound<'py, PyArray2<i64>>, Bound<'py, PyArray1<f64>>)> {
+) -> PyResult<(
+    Nodes<'py>,
+    Bound<'py, PyArray2<i64>>,
+    Bound<'py, PyArray1<f64>>,
+)> {
     let p = profile(z, r_in, r_out)?;
-    let m = p.shell_mesh(n_theta, target_size).map_err(PyDemfemError::from)?;
-    Ok((arr3(py, &m.nodes)?, idx_arr(py, &m.triangles)?, m.thickness.into_pyarray(py)))
+    let m = p
+        .shell_mesh(n_theta, target_size)
+        .map_err(PyDemfemError::from)?;
+    Ok((
+        arr3(py, &m.nodes)?,
+        idx_arr(py, &m.triangles)?,
+        m.thickness.into_pyarray(py),
+    ))
 }
 
-fn prescribed_list(dofs: &PyReadonlyArray2<'_, i64>, values: &PyReadonlyArray1<'_, f64>) -> PyResult<Vec<(usize, usize, f64)>> {
+fn prescribed_list(
+    dofs: &PyReadonlyArray2<'_, i64>,
+    values: &PyReadonlyArray1<'_, f64>,
+) -> PyResult<Vec<(usize, usize, f64)>> {
     let d = dofs.as_array();
     let v = values.as_array();
     if d.ncols() != 2 || d.nrows() != v.len() {
-        return Err(shape_err("fixed_dofs", format!("expected (k, 2) node/component pairs and k values, got {:?} and {}", d.shape(), v.len())));
+        return Err(shape_err(
+            "fixed_dofs",
+            format!(
+                "expected (k, 2) node/component pairs and k values, got {:?} and {}",
+                d.shape(),
+                v.len()
+            ),
+        ));
     }
     d.rows()
         .into_iter()
         .zip(v.iter())
         .map(|(r, &x)| {
             if r[0] < 0 || !(0..3).contains(&r[1]) {
-                Err(shape_err("fixed_dofs", format!("bad pair ({}, {})", r[0], r[1])))
+                Err(shape_err(
+                    "fixed_dofs",
+                    format!("bad pair ({}, {})", r[0], r[1]),
+                ))
             } else {
                 Ok((r[0] as usize, r[1] as usize, x))
             }
@@ -149,10 +208,13 @@ fn fem_solve_static<'py>(
     fixed_values: PyReadonlyArray1<'py, f64>,
 ) -> PyResult<(Nodes<'py>, Nodes<'py>)> {
     let mesh = to_mesh(&nodes, &tets)?;
-    let mat = LinearElastic::new(youngs_modulus, poisson_ratio, 1.0).map_err(PyDemfemError::from)?;
+    let mat =
+        LinearElastic::new(youngs_modulus, poisson_ratio, 1.0).map_err(PyDemfemError::from)?;
     let f = rows3(&loads, "loads")?;
     let fixed = prescribed_list(&fixed_dofs, &fixed_values)?;
-    let sol = py.detach(|| demfem::fem::static_solve::solve_static(&mesh, &mat, &f, &fixed)).map_err(PyDemfemError::from)?;
+    let sol = py
+        .detach(|| demfem::fem::static_solve::solve_static(&mesh, &mat, &f, &fixed))
+        .map_err(PyDemfemError::from)?;
     Ok((arr3(py, &sol.displacement)?, arr3(py, &sol.reaction)?))
 }
 
@@ -167,7 +229,8 @@ fn fem_element_stresses<'py>(
     u: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Nodes<'py>> {
     let mesh = to_mesh(&nodes, &tets)?;
-    let mat = LinearElastic::new(youngs_modulus, poisson_ratio, 1.0).map_err(PyDemfemError::from)?;
+    let mat =
+        LinearElastic::new(youngs_modulus, poisson_ratio, 1.0).map_err(PyDemfemError::from)?;
     let u = rows3(&u, "u")?;
     let s = stress::element_stresses(&mesh, &mat, &u).map_err(PyDemfemError::from)?;
     arr6(py, &s)
@@ -175,10 +238,16 @@ fn fem_element_stresses<'py>(
 
 /// Principal stresses (M,3) Pa, σ1 ≥ σ2 ≥ σ3, and von Mises (M,) Pa of stresses (M,6).
 #[pyfunction]
-fn fem_stress_invariants<'py>(py: Python<'py>, s: PyReadonlyArray2<'py, f64>) -> PyResult<(Nodes<'py>, Bound<'py, PyArray1<f64>>)> {
+fn fem_stress_invariants<'py>(
+    py: Python<'py>,
+    s: PyReadonlyArray2<'py, f64>,
+) -> PyResult<(Nodes<'py>, Bound<'py, PyArray1<f64>>)> {
     let a = s.as_array();
     if a.ncols() != 6 {
-        return Err(shape_err("stress", format!("expected shape (m, 6), got {:?}", a.shape())));
+        return Err(shape_err(
+            "stress",
+            format!("expected shape (m, 6), got {:?}", a.shape()),
+        ));
     }
     let mut p = Vec::with_capacity(a.nrows());
     let mut vm = Vec::with_capacity(a.nrows());
@@ -220,7 +289,8 @@ impl FemTetSolver {
         energy_interval: usize,
     ) -> PyResult<Self> {
         let mesh = to_mesh(&nodes, &tets)?;
-        let material = LinearElastic::new(youngs_modulus, poisson_ratio, density).map_err(PyDemfemError::from)?;
+        let material = LinearElastic::new(youngs_modulus, poisson_ratio, density)
+            .map_err(PyDemfemError::from)?;
         let mut cfg = ExplicitConfig::new(material);
         cfg.dt = dt;
         cfg.safety_factor = safety_factor;
@@ -231,14 +301,26 @@ impl FemTetSolver {
         if !certified_step {
             cfg.step_bound = StepBound::ElementEigenvalue;
         }
-        let inner = py.detach(|| ExplicitSolver::new(&mesh, cfg)).map_err(PyDemfemError::from)?;
-        Ok(Self { inner, mesh, material })
+        let inner = py
+            .detach(|| ExplicitSolver::new(&mesh, cfg))
+            .map_err(PyDemfemError::from)?;
+        Ok(Self {
+            inner,
+            mesh,
+            material,
+        })
     }
 
     /// Prescribe dofs: `dofs` (k,2) node/component, `values` (k,), `kind` 'displacement'
     /// (m, scaled by a linear ramp over `rise_time` s if > 0) or 'velocity' (m/s).
     #[pyo3(signature = (dofs, values, kind="displacement", rise_time=0.0))]
-    fn set_prescribed(&mut self, dofs: PyReadonlyArray2<'_, i64>, values: PyReadonlyArray1<'_, f64>, kind: &str, rise_time: f64) -> PyResult<()> {
+    fn set_prescribed(
+        &mut self,
+        dofs: PyReadonlyArray2<'_, i64>,
+        values: PyReadonlyArray1<'_, f64>,
+        kind: &str,
+        rise_time: f64,
+    ) -> PyResult<()> {
         let list = prescribed_list(&dofs, &values)?;
         let mk: fn(f64) -> PrescribedKind = match kind {
             "displacement" => PrescribedKind::Displacement,
@@ -252,42 +334,75 @@ impl FemTetSolver {
                 .into())
             }
         };
-        let p: Vec<Prescribed> = list.into_iter().map(|(node, component, v)| Prescribed { node, component, kind: mk(v) }).collect();
-        let h = if rise_time > 0.0 { LoadHistory::Ramp { rise_time } } else { LoadHistory::Constant };
-        Ok(self.inner.set_prescribed(&p, h).map_err(PyDemfemError::from)?)
+        let p: Vec<Prescribed> = list
+            .into_iter()
+            .map(|(node, component, v)| Prescribed {
+                node,
+                component,
+                kind: mk(v),
+            })
+            .collect();
+        let h = if rise_time > 0.0 {
+            LoadHistory::Ramp { rise_time }
+        } else {
+            LoadHistory::Constant
+        };
+        Ok(self
+            .inner
+            .set_prescribed(&p, h)
+            .map_err(PyDemfemError::from)?)
     }
 
     /// Nodal loads (N,3) N, applied suddenly or with a smooth ramp over `rise_time` s.
     #[pyo3(signature = (loads, rise_time=0.0))]
     fn set_loads(&mut self, loads: PyReadonlyArray2<'_, f64>, rise_time: f64) -> PyResult<()> {
         let f = rows3(&loads, "loads")?;
-        let h = if rise_time > 0.0 { LoadHistory::SmoothRamp { rise_time } } else { LoadHistory::Constant };
+        let h = if rise_time > 0.0 {
+            LoadHistory::SmoothRamp { rise_time }
+        } else {
+            LoadHistory::Constant
+        };
         Ok(self.inner.set_loads(f, h).map_err(PyDemfemError::from)?)
     }
 
     /// Extra nodal forces (N,3) N held until changed (e.g. contact forces).
     fn set_extra_loads(&mut self, loads: PyReadonlyArray2<'_, f64>) -> PyResult<()> {
         let f = rows3(&loads, "extra_loads")?;
-        Ok(self.inner.set_extra_loads(&f).map_err(PyDemfemError::from)?)
+        Ok(self
+            .inner
+            .set_extra_loads(&f)
+            .map_err(PyDemfemError::from)?)
     }
 
     /// Initial velocity (N,3) m/s (before the first step).
     fn set_initial_velocity(&mut self, v: PyReadonlyArray2<'_, f64>) -> PyResult<()> {
         let v = rows3(&v, "velocity")?;
-        Ok(self.inner.set_initial_velocity(&v).map_err(PyDemfemError::from)?)
+        Ok(self
+            .inner
+            .set_initial_velocity(&v)
+            .map_err(PyDemfemError::from)?)
     }
 
     /// Initial displacement (N,3) m (before the first step).
     fn set_initial_displacement(&mut self, u: PyReadonlyArray2<'_, f64>) -> PyResult<()> {
         let u = rows3(&u, "displacement")?;
-        Ok(self.inner.set_initial_displacement(&u).map_err(PyDemfemError::from)?)
+        Ok(self
+            .inner
+            .set_initial_displacement(&u)
+            .map_err(PyDemfemError::from)?)
     }
 
     /// Advance `n_steps` with the GIL released, in chunks of `chunk` steps; after each
     /// chunk `progress(steps, time_s)` is called if given, and Ctrl-C stops cleanly with
     /// SimulationInterrupted (the state stays consistent at a step boundary).
     #[pyo3(signature = (n_steps, chunk=1000, progress=None))]
-    fn run(&mut self, py: Python<'_>, n_steps: u64, chunk: u64, progress: Option<Bound<'_, PyAny>>) -> PyResult<()> {
+    fn run(
+        &mut self,
+        py: Python<'_>,
+        n_steps: u64,
+        chunk: u64,
+        progress: Option<Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
         crate::run_in_chunks(
             py,
             &mut self.inner,
@@ -353,20 +468,29 @@ impl FemTetSolver {
     }
     /// Element stresses (E,6) Pa, order xx, yy, zz, yz, xz, xy.
     fn element_stresses<'py>(&self, py: Python<'py>) -> PyResult<Nodes<'py>> {
-        let s = stress::element_stresses(&self.mesh, &self.material, self.inner.displacement()).map_err(PyDemfemError::from)?;
+        let s = stress::element_stresses(&self.mesh, &self.material, self.inner.displacement())
+            .map_err(PyDemfemError::from)?;
         arr6(py, &s)
     }
     /// Nodal (volume-averaged) stresses (N,6) Pa.
     fn nodal_stresses<'py>(&self, py: Python<'py>) -> PyResult<Nodes<'py>> {
-        let s = stress::element_stresses(&self.mesh, &self.material, self.inner.displacement()).map_err(PyDemfemError::from)?;
+        let s = stress::element_stresses(&self.mesh, &self.material, self.inner.displacement())
+            .map_err(PyDemfemError::from)?;
         let n = stress::nodal_stresses(&self.mesh, &s).map_err(PyDemfemError::from)?;
         arr6(py, &n)
     }
     /// Write the current state to a .vtu file (displacement, velocity, nodal stress, σ1).
     fn write_vtu(&self, path: std::path::PathBuf) -> PyResult<()> {
-        let u: Vec<f64> = self.inner.displacement().iter().flatten().cloned().collect();
+        let u: Vec<f64> = self
+            .inner
+            .displacement()
+            .iter()
+            .flatten()
+            .cloned()
+            .collect();
         let v: Vec<f64> = self.inner.velocity().iter().flatten().cloned().collect();
-        let es = stress::element_stresses(&self.mesh, &self.material, self.inner.displacement()).map_err(PyDemfemError::from)?;
+        let es = stress::element_stresses(&self.mesh, &self.material, self.inner.displacement())
+            .map_err(PyDemfemError::from)?;
         let ns = stress::nodal_stresses(&self.mesh, &es).map_err(PyDemfemError::from)?;
         let s1: Vec<f64> = ns.iter().map(stress::max_principal_stress).collect();
         let s1e: Vec<f64> = es.iter().map(stress::max_principal_stress).collect();
@@ -376,12 +500,32 @@ impl FemTetSolver {
             &self.mesh.nodes,
             &self.mesh.tets,
             &[
-                DataArray { name: "displacement", n_components: 3, values: &u },
-                DataArray { name: "velocity", n_components: 3, values: &v },
-                DataArray { name: "stress", n_components: 6, values: &nsf },
-                DataArray { name: "sigma1", n_components: 1, values: &s1 },
+                DataArray {
+                    name: "displacement",
+                    n_components: 3,
+                    values: &u,
+                },
+                DataArray {
+                    name: "velocity",
+                    n_components: 3,
+                    values: &v,
+                },
+                DataArray {
+                    name: "stress",
+                    n_components: 6,
+                    values: &nsf,
+                },
+                DataArray {
+                    name: "sigma1",
+                    n_components: 1,
+                    values: &s1,
+                },
             ],
-            &[DataArray { name: "sigma1_element", n_components: 1, values: &s1e }],
+            &[DataArray {
+                name: "sigma1_element",
+                n_components: 1,
+                values: &s1e,
+            }],
         )
         .map_err(PyDemfemError::from)?;
         Ok(())

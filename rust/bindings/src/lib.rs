@@ -66,7 +66,8 @@ pub(crate) fn run_in_chunks<S: Send>(
     let mut done = 0;
     while done < n {
         let k = chunk.min(n - done);
-        py.detach(|| advance(&mut *state, k)).map_err(PyDemfemError::from)?;
+        py.detach(|| advance(&mut *state, k))
+            .map_err(PyDemfemError::from)?;
         done += k;
         after_chunk(state)?;
         if let Err(e) = py.check_signals() {

@@ -8,7 +8,7 @@
 //! frame. Angular velocities are in the world frame (rad/s).
 
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
-use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray2};
+use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
@@ -118,8 +118,10 @@ fn parse_shape(
 #[pyclass(module = "demfem._core")]
 pub struct RigidSimulation {
     scene: RigidScene,
-    /// Principal (body) frame → cartridge frame.
+    /// Principal (body) frame → cartridge frame of the cartridges.
     principal_frame: UnitQuaternion<f64>,
+    /// Which bodies are equivalent spheres (one-bead bodies) rather than cartridges.
+    sphere: Vec<bool>,
 }
 
 #[pymethods]
@@ -128,7 +130,8 @@ impl RigidSimulation {
     #[pyo3(signature = (
         positions, orientations, shape, material, walls, effects, *, velocities=None,
         angular_velocities=None, wall_material=None, gravity=(0.0, 0.0, -9.81), dt=None,
-        expected_max_speed=1.0, removal_plane=None, record_onsets=false
+        expected_max_speed=1.0, removal_plane=None, record_onsets=false, spheres=None,
+        sphere_radius=None
     ))]
     #[allow(clippy::too_many_arguments)]
     fn new(
@@ -147,6 +150,8 @@ impl RigidSimulation {
         expected_max_speed: f64,
         removal_plane: Option<((f64, f64, f64), (f64, f64, f64))>,
         record_onsets: bool,
+        spheres: Option<PyReadonlyArray1<'_, bool>>,
+        sphere_radius: Option<f64>,
     ) -> PyResult<Self> {
         for e in &effects {
             if !RIGID_EFFECTS.contains(&e.as_str()) {
@@ -223,6 +228,50 @@ impl RigidSimulation {
             record_onsets,
         };
         let mut scene = RigidScene::new(config).map_err(PyDemfemError::from)?;
+        let sphere: Vec<bool> = match &spheres {
+            Some(mask) => {
+                let mask = mask.as_array();
+                if mask.len() != n {
+                    return Err(shape_err(
+                        "spheres",
+                        format!("expected {n} flags (one per body), got {}", mask.len()),
+                    ));
+                }
+                mask.to_vec()
+            }
+            None => vec![false; n],
+        };
+        // an equivalent sphere: one bead at the centre of mass, the cartridge's mass, a solid
+        // sphere's inertia 2/5 m r²
+        let sphere_id = if sphere.iter().any(|&s| s) {
+            let radius = match sphere_radius {
+                Some(r) if r.is_finite() && r > 0.0 => r,
+                Some(r) => {
+                    return Err(invalid(
+                        "sphere_radius",
+                        &r.to_string(),
+                        "finite and > 0 (m)",
+                    ))
+                }
+                None => {
+                    return Err(invalid(
+                        "sphere_radius",
+                        "missing",
+                        "required (m) when spheres flags any body",
+                    ))
+                }
+            };
+            let (bead, bead_mass) =
+                BeadClump::from_beads(&[Vector3::zeros()], &[radius], &[mass.mass])
+                    .map_err(PyDemfemError::from)?;
+            Some(
+                scene
+                    .add_shape(RigidShape::Clump(bead), bead_mass)
+                    .map_err(PyDemfemError::from)?,
+            )
+        } else {
+            None
+        };
         let id = scene
             .add_shape(body_shape, mass)
             .map_err(PyDemfemError::from)?;
@@ -237,16 +286,26 @@ impl RigidSimulation {
                 ));
             }
             let user = UnitQuaternion::from_quaternion(raw);
-            let body = user * principal_frame;
+            let (shape_id, body) = match sphere_id {
+                Some(s) if sphere[i] => (s, user),
+                _ => (id, user * principal_frame),
+            };
             let w_body = body.inverse_transform_vector(&to_na(omega[i]));
             scene
-                .add_body(id, to_na(position[i]), body, to_na(velocity[i]), w_body)
+                .add_body(
+                    shape_id,
+                    to_na(position[i]),
+                    body,
+                    to_na(velocity[i]),
+                    w_body,
+                )
                 .map_err(PyDemfemError::from)?;
         }
         let _ = py;
         Ok(RigidSimulation {
             scene,
             principal_frame,
+            sphere,
         })
     }
 
@@ -297,7 +356,7 @@ impl RigidSimulation {
     fn __len__(&self) -> usize {
         self.scene.bodies.len()
     }
-    /// Mass of one body, kg.
+    /// Mass of one body (cartridges and spheres alike), kg.
     #[getter]
     fn body_mass(&self) -> f64 {
         self.scene.bodies.mass.first().copied().unwrap_or(0.0)
@@ -324,25 +383,35 @@ impl RigidSimulation {
     /// Orientations of the cartridge frames, quaternions (w, x, y, z), shape (N, 4).
     fn orientations<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let mut flat = Vec::with_capacity(4 * self.scene.bodies.len());
-        for q in &self.scene.bodies.orientation {
-            let user = q * self.principal_frame.inverse();
+        for (q, &sphere) in self.scene.bodies.orientation.iter().zip(&self.sphere) {
+            let user = if sphere {
+                *q
+            } else {
+                q * self.principal_frame.inverse()
+            };
             flat.extend([user.w, user.i, user.j, user.k]);
         }
         let n = self.scene.bodies.len();
         Ok(flat.into_pyarray(py).reshape([n, 4])?.into_any())
     }
-    /// Cartridge axes (the frame's z, bottom to top) in the world frame, shape (N, 3).
+    /// Cartridge axes (the frame's z, bottom to top) in the world frame, shape (N, 3); NaN
+    /// for spheres.
     fn axes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let v: Vec<Vec3> = self.axes_na().iter().map(from_na).collect();
         array_n3(py, &v)
     }
-    /// Angle between each cartridge axis and the vertical +z, rad (0: upright).
+    /// Angle between each cartridge axis and the vertical +z, rad (0: upright); NaN for
+    /// spheres.
     fn tilt_angles<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         self.axes_na()
             .iter()
             .map(|a| a.z.clamp(-1.0, 1.0).acos())
             .collect::<Vec<_>>()
             .into_pyarray(py)
+    }
+    /// Whether each body is an equivalent sphere (True) or a cartridge.
+    fn is_sphere<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
+        self.sphere.clone().into_pyarray(py)
     }
     /// Whether each body is still on the table (not removed through the outlet).
     fn alive<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
@@ -466,7 +535,14 @@ impl RigidSimulation {
             .bodies
             .orientation
             .iter()
-            .map(|q| q * axis_body)
+            .zip(&self.sphere)
+            .map(|(q, &sphere)| {
+                if sphere {
+                    Vector3::repeat(f64::NAN)
+                } else {
+                    q * axis_body
+                }
+            })
             .collect()
     }
 }

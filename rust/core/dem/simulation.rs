@@ -1217,8 +1217,9 @@ impl Simulation {
             let r_star = self.radius[i] * self.radius[j] / r_sum;
             let m_star = self.mass[i] * self.mass[j] / (self.mass[i] + self.mass[j]);
             let law = self.material[i] as usize * nm + self.material[j] as usize;
-            self.pair_const
-                .push(ContactConst::new(self.model, &self.laws, law, r_star, m_star));
+            self.pair_const.push(ContactConst::new(
+                self.model, &self.laws, law, r_star, m_star,
+            ));
         }
         let stride = self.wall_stride;
         for (k, s) in self.wall_slots.iter_mut().enumerate() {
@@ -1387,7 +1388,12 @@ impl Simulation {
         // lasts microseconds, so fewer, larger tasks beat finer load balancing
         let tasks = 2 * self.threads.max(1);
         let pair_min = self.pairs.len().div_ceil(PAIR_CHUNK).div_ceil(tasks).max(1);
-        let particle_min = self.position.len().div_ceil(PARTICLE_CHUNK).div_ceil(tasks).max(1);
+        let particle_min = self
+            .position
+            .len()
+            .div_ceil(PARTICLE_CHUNK)
+            .div_ceil(tasks)
+            .max(1);
         // ---- force phase: every pair and every wall slot writes its own record only
         {
             let pair_ctx = PairCtx {
@@ -1803,7 +1809,11 @@ impl Simulation {
     pub fn reinsert_particle(&mut self, i: usize, position: Vec3, velocity: Vec3) -> Result<()> {
         let n = self.position.len();
         if i >= n {
-            return Err(DemfemError::invalid("particle index", i as f64, &format!("< {n}")));
+            return Err(DemfemError::invalid(
+                "particle index",
+                i as f64,
+                &format!("< {n}"),
+            ));
         }
         if self.alive[i] {
             return Err(DemfemError::invalid(

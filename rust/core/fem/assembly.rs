@@ -12,15 +12,25 @@ pub fn precompute_tets(mesh: &TetMesh) -> Result<Vec<Tet4>> {
         .iter()
         .enumerate()
         .map(|(e, t)| {
-            Tet4::new([mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]], mesh.nodes[t[3]]])
-                .map_err(|err| DemfemError::Numerical(format!("element {e}: {err}")))
+            Tet4::new([
+                mesh.nodes[t[0]],
+                mesh.nodes[t[1]],
+                mesh.nodes[t[2]],
+                mesh.nodes[t[3]],
+            ])
+            .map_err(|err| DemfemError::Numerical(format!("element {e}: {err}")))
         })
         .collect()
 }
 
 /// Lumped (row-sum) nodal masses, kg: each node receives ρ V s_e / 4 from every element e,
 /// `mass_factor[e]` = s_e ≥ 1 being the optional mass-scaling factor (`None` = 1).
-pub fn lumped_mass(mesh: &TetMesh, tets: &[Tet4], density: f64, mass_factor: Option<&[f64]>) -> Result<Vec<f64>> {
+pub fn lumped_mass(
+    mesh: &TetMesh,
+    tets: &[Tet4],
+    density: f64,
+    mass_factor: Option<&[f64]>,
+) -> Result<Vec<f64>> {
     check_positive("density", density)?;
     let mut m = vec![0.0; mesh.nodes.len()];
     for (e, (t, g)) in mesh.tets.iter().zip(tets).enumerate() {
@@ -85,7 +95,13 @@ impl NodeAdjacency {
 /// Stiffness triplets (row dof, column dof, value in N/m) of the whole mesh, dof = 3·node +
 /// component; duplicates are to be summed. Only entries with row ≥ column (lower triangle)
 /// are returned when `lower_only`.
-pub fn stiffness_triplets(mesh: &TetMesh, tets: &[Tet4], lambda: f64, mu: f64, lower_only: bool) -> Vec<(usize, usize, f64)> {
+pub fn stiffness_triplets(
+    mesh: &TetMesh,
+    tets: &[Tet4],
+    lambda: f64,
+    mu: f64,
+    lower_only: bool,
+) -> Vec<(usize, usize, f64)> {
     let mut out = Vec::with_capacity(mesh.tets.len() * if lower_only { 78 } else { 144 });
     for (t, g) in mesh.tets.iter().zip(tets) {
         let k = g.stiffness(lambda, mu);
@@ -110,18 +126,29 @@ pub fn stiffness_triplets(mesh: &TetMesh, tets: &[Tet4], lambda: f64, mu: f64, l
 /// into the body) on the boundary faces whose three nodes all satisfy `on_surface`
 /// (called with node coordinates in m). For a linear triangle the consistent load is
 /// p·A/3 per node along the inward normal. Returns one force per node.
-pub fn surface_pressure_loads(mesh: &TetMesh, pressure: f64, on_surface: impl Fn([f64; 3]) -> bool) -> Result<Vec<[f64; 3]>> {
+pub fn surface_pressure_loads(
+    mesh: &TetMesh,
+    pressure: f64,
+    on_surface: impl Fn([f64; 3]) -> bool,
+) -> Result<Vec<[f64; 3]>> {
     if !pressure.is_finite() {
         return Err(DemfemError::invalid("pressure", pressure, "finite"));
     }
     let mut f = vec![[0.0; 3]; mesh.nodes.len()];
     for face in mesh.boundary_faces() {
-        let p = [mesh.nodes[face[0]], mesh.nodes[face[1]], mesh.nodes[face[2]]];
+        let p = [
+            mesh.nodes[face[0]],
+            mesh.nodes[face[1]],
+            mesh.nodes[face[2]],
+        ];
         if !p.iter().all(|&x| on_surface(x)) {
             continue;
         }
         // cross of the edges = 2·A·n_out; the load is −p·A·n_out split equally.
-        let n2 = cross(crate::fem::mesh::sub(p[1], p[0]), crate::fem::mesh::sub(p[2], p[0]));
+        let n2 = cross(
+            crate::fem::mesh::sub(p[1], p[0]),
+            crate::fem::mesh::sub(p[2], p[0]),
+        );
         for &node in &face {
             for c in 0..3 {
                 f[node][c] -= pressure * n2[c] / 6.0;

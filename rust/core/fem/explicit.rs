@@ -28,7 +28,10 @@ use crate::fem::assembly::{lumped_mass, precompute_tets, NodeAdjacency};
 use crate::fem::element::Tet4;
 use crate::fem::material::LinearElastic;
 use crate::fem::mesh::TetMesh;
-use crate::fem::stable_step::{certified_eigenvalue_bound, critical_step_from_eigenvalue, mass_scaling_factors, EigenvalueBound, StepBound};
+use crate::fem::stable_step::{
+    certified_eigenvalue_bound, critical_step_from_eigenvalue, mass_scaling_factors,
+    EigenvalueBound, StepBound,
+};
 
 /// Elements per parallel work item (fixed, so chunking does not depend on the thread count).
 const ELEMENT_CHUNK: usize = 2048;
@@ -98,7 +101,11 @@ pub struct Prescribed {
 impl Prescribed {
     /// Fix all three components of `node` (zero displacement).
     pub fn fix_node(node: usize) -> [Prescribed; 3] {
-        [0, 1, 2].map(|component| Prescribed { node, component, kind: PrescribedKind::Displacement(0.0) })
+        [0, 1, 2].map(|component| Prescribed {
+            node,
+            component,
+            kind: PrescribedKind::Displacement(0.0),
+        })
     }
 }
 
@@ -135,7 +142,10 @@ impl ExplicitConfig {
             rayleigh_beta: 0.0,
             mass_scaling_dt: None,
             energy_interval: 100,
-            step_bound: StepBound::CertifiedGlobal { margin: 0.01, iterations: 400 },
+            step_bound: StepBound::CertifiedGlobal {
+                margin: 0.01,
+                iterations: 400,
+            },
         }
     }
 }
@@ -164,7 +174,13 @@ impl EnergyReport {
     }
     /// Balance error relative to max(|E_kin|, E_int, |W_ext|, W_damp, |E_0|) (0 when all vanish).
     pub fn relative_balance_error(&self) -> f64 {
-        let scale = self.kinetic.abs().max(self.internal).max(self.external_work.abs()).max(self.damping_work).max(self.initial.abs());
+        let scale = self
+            .kinetic
+            .abs()
+            .max(self.internal)
+            .max(self.external_work.abs())
+            .max(self.damping_work)
+            .max(self.initial.abs());
         if scale > 0.0 {
             self.balance_error() / scale
         } else {
@@ -189,12 +205,22 @@ impl TetForceKernel {
     pub fn new(mesh: &TetMesh, lambda: f64, mu: f64) -> Result<Self> {
         mesh.validate()?;
         if mesh.nodes.len() >= u32::MAX as usize {
-            return Err(DemfemError::ShapeMismatch { field: "mesh.nodes".into(), detail: "too many nodes for 32-bit indices".into() });
+            return Err(DemfemError::ShapeMismatch {
+                field: "mesh.nodes".into(),
+                detail: "too many nodes for 32-bit indices".into(),
+            });
         }
         let tets = precompute_tets(mesh)?;
         let conn = mesh.tets.iter().map(|t| t.map(|i| i as u32)).collect();
         let adjacency = NodeAdjacency::new(&mesh.tets, mesh.nodes.len())?;
-        Ok(Self { tets, conn, adjacency, lambda, mu, buffer: vec![[0.0; 3]; mesh.tets.len() * 4] })
+        Ok(Self {
+            tets,
+            conn,
+            adjacency,
+            lambda,
+            mu,
+            buffer: vec![[0.0; 3]; mesh.tets.len() * 4],
+        })
     }
 
     /// Precomputed element geometry.
@@ -213,29 +239,34 @@ impl TetForceKernel {
         let (lambda, mu) = (self.lambda, self.mu);
         let tets = &self.tets;
         let conn = &self.conn;
-        self.buffer.par_chunks_mut(4 * ELEMENT_CHUNK).enumerate().for_each(|(c, chunk)| {
-            let e0 = c * ELEMENT_CHUNK;
-            for (k, out_e) in chunk.chunks_exact_mut(4).enumerate() {
-                let e = e0 + k;
-                tet_force(&tets[e], conn[e], u, lambda, mu, out_e);
-            }
-        });
+        self.buffer
+            .par_chunks_mut(4 * ELEMENT_CHUNK)
+            .enumerate()
+            .for_each(|(c, chunk)| {
+                let e0 = c * ELEMENT_CHUNK;
+                for (k, out_e) in chunk.chunks_exact_mut(4).enumerate() {
+                    let e = e0 + k;
+                    tet_force(&tets[e], conn[e], u, lambda, mu, out_e);
+                }
+            });
         let buffer = &self.buffer;
         let adj = &self.adjacency;
-        out.par_chunks_mut(NODE_CHUNK).enumerate().for_each(|(c, chunk)| {
-            let n0 = c * NODE_CHUNK;
-            for (k, f) in chunk.iter_mut().enumerate() {
-                let n = n0 + k;
-                let mut s = [0.0; 3];
-                for &en in &adj.entries[adj.offsets[n] as usize..adj.offsets[n + 1] as usize] {
-                    let b = buffer[en as usize];
-                    s[0] += b[0];
-                    s[1] += b[1];
-                    s[2] += b[2];
+        out.par_chunks_mut(NODE_CHUNK)
+            .enumerate()
+            .for_each(|(c, chunk)| {
+                let n0 = c * NODE_CHUNK;
+                for (k, f) in chunk.iter_mut().enumerate() {
+                    let n = n0 + k;
+                    let mut s = [0.0; 3];
+                    for &en in &adj.entries[adj.offsets[n] as usize..adj.offsets[n + 1] as usize] {
+                        let b = buffer[en as usize];
+                        s[0] += b[0];
+                        s[1] += b[1];
+                        s[2] += b[2];
+                    }
+                    *f = s;
                 }
-                *f = s;
-            }
-        });
+            });
     }
 }
 
@@ -289,7 +320,11 @@ fn det_sum<F: Fn(usize) -> f64 + Sync>(n: usize, f: F) -> f64 {
 /// Largest eigenvalue of M⁻¹K (1/s²) of the assembled, unconstrained mesh by power
 /// iteration on M^{-½}KM^{-½}, using the same element kernel. The Rayleigh quotient
 /// approaches λ_max from below; `iterations` ≥ a few hundred for small meshes.
-pub fn global_max_eigenvalue(kernel: &mut TetForceKernel, mass: &[f64], iterations: usize) -> Result<f64> {
+pub fn global_max_eigenvalue(
+    kernel: &mut TetForceKernel,
+    mass: &[f64],
+    iterations: usize,
+) -> Result<f64> {
     let n = mass.len();
     // Deterministic, non-symmetric start vector so no mode is missing from it.
     let mut x: Vec<[f64; 3]> = (0..n)
@@ -302,9 +337,14 @@ pub fn global_max_eigenvalue(kernel: &mut TetForceKernel, mass: &[f64], iteratio
     let mut tmp = vec![[0.0; 3]; n];
     let mut lam = 0.0;
     for _ in 0..iterations {
-        let nx = det_sum(n, |i| x[i][0] * x[i][0] + x[i][1] * x[i][1] + x[i][2] * x[i][2]).sqrt();
+        let nx = det_sum(n, |i| {
+            x[i][0] * x[i][0] + x[i][1] * x[i][1] + x[i][2] * x[i][2]
+        })
+        .sqrt();
         if !(nx > 0.0) || !nx.is_finite() {
-            return Err(DemfemError::Numerical("power iteration vector vanished".into()));
+            return Err(DemfemError::Numerical(
+                "power iteration vector vanished".into(),
+            ));
         }
         for (i, xi) in x.iter_mut().enumerate() {
             for c in 0..3 {
@@ -318,7 +358,9 @@ pub fn global_max_eigenvalue(kernel: &mut TetForceKernel, mass: &[f64], iteratio
                 yi[c] /= mass[i].sqrt();
             }
         }
-        lam = det_sum(n, |i| x[i][0] * y[i][0] + x[i][1] * y[i][1] + x[i][2] * y[i][2]);
+        lam = det_sum(n, |i| {
+            x[i][0] * y[i][0] + x[i][1] * y[i][1] + x[i][2] * y[i][2]
+        });
         std::mem::swap(&mut x, &mut y);
     }
     Ok(lam)
@@ -376,9 +418,20 @@ impl ExplicitSolver {
         };
         let mass = lumped_mass(mesh, kernel.tets(), rho, factors.as_deref())?;
         let mut kernel = kernel;
-        let eigen = certified_eigenvalue_bound(mesh, &mut kernel, &mass, &config.material, factors.as_deref(), config.step_bound)?;
+        let eigen = certified_eigenvalue_bound(
+            mesh,
+            &mut kernel,
+            &mass,
+            &config.material,
+            factors.as_deref(),
+            config.step_bound,
+        )?;
         let critical_element = eigen.critical_element;
-        let dt_limit = critical_step_from_eigenvalue(eigen.bound, config.rayleigh_alpha, config.rayleigh_beta)?;
+        let dt_limit = critical_step_from_eigenvalue(
+            eigen.bound,
+            config.rayleigh_alpha,
+            config.rayleigh_beta,
+        )?;
         let dt = match config.dt {
             Some(dt) => {
                 check_positive("dt", dt)?;
@@ -430,14 +483,21 @@ impl ExplicitSolver {
 
     fn check_len(&self, field: &str, len: usize) -> Result<()> {
         if len != self.mass.len() {
-            return Err(DemfemError::ShapeMismatch { field: field.into(), detail: format!("{len} entries for {} nodes", self.mass.len()) });
+            return Err(DemfemError::ShapeMismatch {
+                field: field.into(),
+                detail: format!("{len} entries for {} nodes", self.mass.len()),
+            });
         }
         Ok(())
     }
 
     /// Prescribe degrees of freedom (replaces any earlier prescription); `history` scales
     /// prescribed displacements in time.
-    pub fn set_prescribed(&mut self, prescribed: &[Prescribed], history: LoadHistory) -> Result<()> {
+    pub fn set_prescribed(
+        &mut self,
+        prescribed: &[Prescribed],
+        history: LoadHistory,
+    ) -> Result<()> {
         history.validate()?;
         let n = self.mass.len();
         let mut kind = vec![[0u8; 3]; n];
@@ -446,7 +506,10 @@ impl ExplicitSolver {
             if p.node >= n || p.component > 2 {
                 return Err(DemfemError::ShapeMismatch {
                     field: "prescribed".into(),
-                    detail: format!("node {} component {} out of range ({n} nodes)", p.node, p.component),
+                    detail: format!(
+                        "node {} component {} out of range ({n} nodes)",
+                        p.node, p.component
+                    ),
                 });
             }
             let (k, v) = match p.kind {
@@ -506,7 +569,9 @@ impl ExplicitSolver {
 
     fn require_start(&self, what: &str) -> Result<()> {
         if self.steps > 0 {
-            return Err(DemfemError::Effect(format!("{what} can only be set before the first step")));
+            return Err(DemfemError::Effect(format!(
+                "{what} can only be set before the first step"
+            )));
         }
         Ok(())
     }
@@ -594,11 +659,23 @@ impl ExplicitSolver {
 
     fn check_finite(&self) -> Result<()> {
         let bad = det_sum(self.u.len(), |i| {
-            let s = self.u[i][0] + self.u[i][1] + self.u[i][2] + self.v[i][0] + self.v[i][1] + self.v[i][2];
-            if s.is_finite() { 0.0 } else { 1.0 }
+            let s = self.u[i][0]
+                + self.u[i][1]
+                + self.u[i][2]
+                + self.v[i][0]
+                + self.v[i][1]
+                + self.v[i][2];
+            if s.is_finite() {
+                0.0
+            } else {
+                1.0
+            }
         });
         if bad > 0.0 {
-            return Err(DemfemError::Numerical(format!("non-finite displacement or velocity at t = {:e} s", self.time)));
+            return Err(DemfemError::Numerical(format!(
+                "non-finite displacement or velocity at t = {:e} s",
+                self.time
+            )));
         }
         Ok(())
     }
@@ -659,7 +736,11 @@ impl ExplicitSolver {
                             let (v_new, reaction) = match bc_kind[i][d] {
                                 0 => (v_old + dt_n * resid / m, 0.0),
                                 kind => {
-                                    let vn = if kind == 1 { (bc_value[i][d] * bf_next - u_old) / dt } else { bc_value[i][d] };
+                                    let vn = if kind == 1 {
+                                        (bc_value[i][d] * bf_next - u_old) / dt
+                                    } else {
+                                        bc_value[i][d]
+                                    };
                                     let a = (vn - v_old) / dt_n;
                                     (vn, m * a - resid)
                                 }
@@ -695,7 +776,11 @@ impl ExplicitSolver {
             internal: e_int,
             external_work: self.energy.external_work + w_ext,
             damping_work: self.energy.damping_work + w_damp,
-            initial: if first { e_kin + e_int } else { self.energy.initial },
+            initial: if first {
+                e_kin + e_int
+            } else {
+                self.energy.initial
+            },
         };
         let ei = self.config.energy_interval;
         if ei > 0 && self.steps % ei as u64 == 0 {

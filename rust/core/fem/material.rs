@@ -19,12 +19,20 @@ impl LinearElastic {
         check_positive("youngs_modulus", youngs_modulus)?;
         check_open("poisson_ratio", poisson_ratio, -1.0, 0.5)?;
         check_positive("density", density)?;
-        Ok(Self { youngs_modulus, poisson_ratio, density })
+        Ok(Self {
+            youngs_modulus,
+            poisson_ratio,
+            density,
+        })
     }
 
     /// The paper's glass: E = 45 GPa, ν = 0.2, ρ = 2230 kg/m³ (DESIGN.md §4).
     pub fn paper_glass() -> Self {
-        Self { youngs_modulus: 45e9, poisson_ratio: 0.2, density: 2230.0 }
+        Self {
+            youngs_modulus: 45e9,
+            poisson_ratio: 0.2,
+            density: 2230.0,
+        }
     }
 
     /// Re-check a material built by struct literal.

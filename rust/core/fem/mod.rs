@@ -23,6 +23,8 @@ pub mod stable_step;
 pub mod static_solve;
 pub mod stress;
 
-pub use explicit::{ExplicitConfig, ExplicitSolver, EnergyReport, Prescribed, PrescribedKind, LoadHistory};
+pub use explicit::{
+    EnergyReport, ExplicitConfig, ExplicitSolver, LoadHistory, Prescribed, PrescribedKind,
+};
 pub use material::LinearElastic;
 pub use mesh::{AxisymmetricProfile, MeshQuality, TetMesh, TriMesh};

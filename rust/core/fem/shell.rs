@@ -30,7 +30,11 @@ impl ShellModel {
             .zip(&mesh.thickness)
             .map(|(t, &h)| ShellTri::new([mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]], h))
             .collect::<Result<Vec<_>>>()?;
-        Ok(Self { mesh, material, elements })
+        Ok(Self {
+            mesh,
+            material,
+            elements,
+        })
     }
 
     /// Number of dofs (6 per node).
@@ -78,7 +82,10 @@ impl ShellModel {
         let mut pres = vec![None; nd];
         for &(n, k, v) in fixed {
             if n >= self.mesh.nodes.len() || k > 5 {
-                return Err(DemfemError::ShapeMismatch { field: "fixed".into(), detail: format!("node {n} dof {k} out of range") });
+                return Err(DemfemError::ShapeMismatch {
+                    field: "fixed".into(),
+                    detail: format!("node {n} dof {k} out of range"),
+                });
             }
             pres[6 * n + k] = Some(v);
         }
@@ -90,7 +97,10 @@ impl ShellModel {
     /// top surfaces, for the dof vector `x` from [`Self::solve_static`].
     pub fn max_principal_stresses(&self, x: &[f64]) -> Result<Vec<[f64; 3]>> {
         if x.len() != self.n_dofs() {
-            return Err(DemfemError::ShapeMismatch { field: "x".into(), detail: format!("expected {} dofs", self.n_dofs()) });
+            return Err(DemfemError::ShapeMismatch {
+                field: "x".into(),
+                detail: format!("expected {} dofs", self.n_dofs()),
+            });
         }
         let (e, nu) = (self.material.youngs_modulus, self.material.poisson_ratio);
         Ok(self
@@ -148,7 +158,11 @@ impl ShellExplicit {
     pub fn new(model: &ShellModel, fixed: &[(usize, usize)], dt: Option<f64>) -> Result<Self> {
         use nalgebra::SymmetricEigen;
         let nn = model.mesh.nodes.len();
-        let (e, nu, rho) = (model.material.youngs_modulus, model.material.poisson_ratio, model.material.density);
+        let (e, nu, rho) = (
+            model.material.youngs_modulus,
+            model.material.poisson_ratio,
+            model.material.density,
+        );
         // Symmetrised exactly, so K_e u can be evaluated as columns · u (contiguous in
         // nalgebra's column-major storage).
         let k_e: Vec<_> = model
@@ -176,7 +190,11 @@ impl ShellExplicit {
                     s[(i, j)] /= (me[i % 6] * me[j % 6]).sqrt();
                 }
             }
-            let l = SymmetricEigen::new(s).eigenvalues.iter().cloned().fold(0.0f64, f64::max);
+            let l = SymmetricEigen::new(s)
+                .eigenvalues
+                .iter()
+                .cloned()
+                .fold(0.0f64, f64::max);
             lam_max = lam_max.max(l);
         }
         let dt_limit = crate::fem::stable_step::critical_step_from_eigenvalue(lam_max, 0.0, 0.0)?;
@@ -184,7 +202,11 @@ impl ShellExplicit {
             Some(d) => {
                 crate::error::check_positive("dt", d)?;
                 if d > dt_limit {
-                    return Err(DemfemError::UnstableTimeStep { dt: d, limit: dt_limit, reason: "shell element eigenvalue bound".into() });
+                    return Err(DemfemError::UnstableTimeStep {
+                        dt: d,
+                        limit: dt_limit,
+                        reason: "shell element eigenvalue bound".into(),
+                    });
                 }
                 d
             }
@@ -193,11 +215,19 @@ impl ShellExplicit {
         let mut free = vec![true; 6 * nn];
         for &(n, k) in fixed {
             if n >= nn || k > 5 {
-                return Err(DemfemError::ShapeMismatch { field: "fixed".into(), detail: format!("node {n} dof {k} out of range") });
+                return Err(DemfemError::ShapeMismatch {
+                    field: "fixed".into(),
+                    detail: format!("node {n} dof {k} out of range"),
+                });
             }
             free[6 * n + k] = false;
         }
-        let conn4: Vec<[usize; 4]> = model.mesh.triangles.iter().map(|t| [t[0], t[1], t[2], t[2]]).collect();
+        let conn4: Vec<[usize; 4]> = model
+            .mesh
+            .triangles
+            .iter()
+            .map(|t| [t[0], t[1], t[2], t[2]])
+            .collect();
         // Reuse the tet adjacency with a repeated last node; the duplicate entry (local 3)
         // is skipped in the gather.
         let adjacency = crate::fem::assembly::NodeAdjacency::new(&conn4, nn)?;
@@ -242,13 +272,20 @@ impl ShellExplicit {
     pub fn relative_balance_error(&self) -> f64 {
         let [k, i, w, e0] = self.energy;
         let scale = k.abs().max(i).max(w.abs()).max(e0.abs());
-        if scale > 0.0 { (k + i - w - e0).abs() / scale } else { 0.0 }
+        if scale > 0.0 {
+            (k + i - w - e0).abs() / scale
+        } else {
+            0.0
+        }
     }
 
     /// Constant nodal loads (N, N·m), length 6 × nodes.
     pub fn set_loads(&mut self, f: &[f64]) -> Result<()> {
         if f.len() != self.loads.len() || f.iter().any(|x| !x.is_finite()) {
-            return Err(DemfemError::ShapeMismatch { field: "loads".into(), detail: format!("{} finite values expected", self.loads.len()) });
+            return Err(DemfemError::ShapeMismatch {
+                field: "loads".into(),
+                detail: format!("{} finite values expected", self.loads.len()),
+            });
         }
         self.loads.copy_from_slice(f);
         Ok(())
@@ -257,7 +294,10 @@ impl ShellExplicit {
     /// Initial dof vector (m, rad); before the first step only.
     pub fn set_initial_displacement(&mut self, u: &[f64]) -> Result<()> {
         if u.len() != self.u.len() || self.steps > 0 {
-            return Err(DemfemError::ShapeMismatch { field: "u0".into(), detail: "wrong length or solver already started".into() });
+            return Err(DemfemError::ShapeMismatch {
+                field: "u0".into(),
+                detail: "wrong length or solver already started".into(),
+            });
         }
         self.u.copy_from_slice(u);
         Ok(())
@@ -320,7 +360,10 @@ impl ShellExplicit {
             let m = self.mass[d];
             let v_old = self.v[d];
             let (v_new, f_tot) = if self.free[d] {
-                (v_old + dt_n * (self.loads[d] - self.f[d]) / m, self.loads[d])
+                (
+                    v_old + dt_n * (self.loads[d] - self.f[d]) / m,
+                    self.loads[d],
+                )
             } else {
                 let a = -v_old / dt_n;
                 (0.0, m * a + self.f[d])

@@ -18,7 +18,13 @@ use crate::fem::element::Tet4;
 
 /// Largest element eigenvalue max_e λ_max(M_e⁻¹K_e), 1/s², and the element that attains it.
 /// `mass_factor[e]` scales the element mass (mass scaling; `None` = 1).
-pub fn element_eigenvalue_bound(tets: &[Tet4], lambda: f64, mu: f64, density: f64, mass_factor: Option<&[f64]>) -> (f64, usize) {
+pub fn element_eigenvalue_bound(
+    tets: &[Tet4],
+    lambda: f64,
+    mu: f64,
+    density: f64,
+    mass_factor: Option<&[f64]>,
+) -> (f64, usize) {
     let eigs = element_eigenvalues(tets, lambda, mu, density, mass_factor);
     let mut best = (0.0, 0);
     for (e, &l) in eigs.iter().enumerate() {
@@ -31,7 +37,13 @@ pub fn element_eigenvalue_bound(tets: &[Tet4], lambda: f64, mu: f64, density: f6
 
 /// Every element's λ_max(M_e⁻¹K_e), 1/s² (parallel; each entry is independent, so the
 /// result does not depend on the number of threads).
-pub fn element_eigenvalues(tets: &[Tet4], lambda: f64, mu: f64, density: f64, mass_factor: Option<&[f64]>) -> Vec<f64> {
+pub fn element_eigenvalues(
+    tets: &[Tet4],
+    lambda: f64,
+    mu: f64,
+    density: f64,
+    mass_factor: Option<&[f64]>,
+) -> Vec<f64> {
     tets.par_iter()
         .enumerate()
         .map(|(e, t)| t.max_eigenvalue(lambda, mu, density, mass_factor.map_or(1.0, |f| f[e])))
@@ -45,7 +57,9 @@ pub fn critical_step_from_eigenvalue(omega_sq: f64, alpha: f64, beta: f64) -> Re
     check_non_negative("alpha", alpha)?;
     check_non_negative("beta", beta)?;
     if !(omega_sq > 0.0) || !omega_sq.is_finite() {
-        return Err(DemfemError::Numerical(format!("largest eigenvalue {omega_sq:e} is not positive and finite")));
+        return Err(DemfemError::Numerical(format!(
+            "largest eigenvalue {omega_sq:e} is not positive and finite"
+        )));
     }
     let w = omega_sq.sqrt();
     let xi = (alpha + beta * omega_sq) / (2.0 * w);
@@ -55,7 +69,13 @@ pub fn critical_step_from_eigenvalue(omega_sq: f64, alpha: f64, beta: f64) -> Re
 /// Element mass-scaling factors s_e ≥ 1 such that every element's own stable step is at
 /// least `target_dt` (s): s_e = max(1, (target_dt / dt_e)²) with dt_e = 2/√λ_e.
 /// Returns the factors and the added mass (kg) Σ (s_e − 1) ρ V_e.
-pub fn mass_scaling_factors(tets: &[Tet4], lambda: f64, mu: f64, density: f64, target_dt: f64) -> Result<(Vec<f64>, f64)> {
+pub fn mass_scaling_factors(
+    tets: &[Tet4],
+    lambda: f64,
+    mu: f64,
+    density: f64,
+    target_dt: f64,
+) -> Result<(Vec<f64>, f64)> {
     crate::error::check_positive("target_dt", target_dt)?;
     let eigs = element_eigenvalues(tets, lambda, mu, density, None);
     let mut added = 0.0;
@@ -116,11 +136,20 @@ pub fn certified_eigenvalue_bound(
 ) -> Result<EigenvalueBound> {
     use faer::sparse::{SparseColMat, Triplet};
     let (lambda, mu) = material.lame();
-    let (lam_e, crit) = element_eigenvalue_bound(kernel.tets(), lambda, mu, material.density, mass_factor);
-    let mut out = EigenvalueBound { bound: lam_e, element_bound: lam_e, power_estimate: 0.0, factorizations: 0, critical_element: crit };
+    let (lam_e, crit) =
+        element_eigenvalue_bound(kernel.tets(), lambda, mu, material.density, mass_factor);
+    let mut out = EigenvalueBound {
+        bound: lam_e,
+        element_bound: lam_e,
+        power_estimate: 0.0,
+        factorizations: 0,
+        critical_element: crit,
+    };
     let (margin, iterations) = match how {
         StepBound::ElementEigenvalue => return Ok(out),
-        StepBound::CertifiedGlobal { margin, iterations } => (crate::error::check_positive("margin", margin)?, iterations),
+        StepBound::CertifiedGlobal { margin, iterations } => {
+            (crate::error::check_positive("margin", margin)?, iterations)
+        }
     };
     let lam_p = crate::fem::explicit::global_max_eigenvalue(kernel, mass, iterations.max(1))?;
     out.power_estimate = lam_p;
@@ -132,7 +161,10 @@ pub fn certified_eigenvalue_bound(
         if !(sigma < lam_e) {
             return Ok(out);
         }
-        let mut t: Vec<Triplet<usize, usize, f64>> = trips.iter().map(|&(r, c, v)| Triplet::new(r, c, -v)).collect();
+        let mut t: Vec<Triplet<usize, usize, f64>> = trips
+            .iter()
+            .map(|&(r, c, v)| Triplet::new(r, c, -v))
+            .collect();
         t.extend((0..nd).map(|d| Triplet::new(d, d, sigma * mass[d / 3])));
         let a = SparseColMat::<usize, f64>::try_new_from_triplets(nd, nd, &t)
             .map_err(|e| DemfemError::Numerical(format!("assembling σM − K failed: {e:?}")))?;
@@ -143,7 +175,11 @@ pub fn certified_eigenvalue_bound(
                 return Ok(out);
             }
             Err(faer::sparse::linalg::LltError::Numeric(_)) => k += 1,
-            Err(e) => return Err(DemfemError::Numerical(format!("factorising σM − K failed: {e:?}"))),
+            Err(e) => {
+                return Err(DemfemError::Numerical(format!(
+                    "factorising σM − K failed: {e:?}"
+                )))
+            }
         }
         if k > 30 {
             return Ok(out);

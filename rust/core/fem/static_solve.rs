@@ -25,18 +25,29 @@ pub struct StaticSolution {
 /// dofs in `prescribed` — (node, component, value in m) — fixed. The prescription must
 /// remove all rigid-body modes, otherwise the factorisation fails with
 /// [`DemfemError::Numerical`].
-pub fn solve_static(mesh: &TetMesh, material: &LinearElastic, loads: &[[f64; 3]], prescribed: &[(usize, usize, f64)]) -> Result<StaticSolution> {
+pub fn solve_static(
+    mesh: &TetMesh,
+    material: &LinearElastic,
+    loads: &[[f64; 3]],
+    prescribed: &[(usize, usize, f64)],
+) -> Result<StaticSolution> {
     mesh.validate()?;
     material.validate()?;
     let n = mesh.nodes.len();
     if loads.len() != n {
-        return Err(DemfemError::ShapeMismatch { field: "loads".into(), detail: format!("{} entries for {n} nodes", loads.len()) });
+        return Err(DemfemError::ShapeMismatch {
+            field: "loads".into(),
+            detail: format!("{} entries for {n} nodes", loads.len()),
+        });
     }
     let ndof = 3 * n;
     let mut fixed: Vec<Option<f64>> = vec![None; ndof];
     for &(node, c, v) in prescribed {
         if node >= n || c > 2 {
-            return Err(DemfemError::ShapeMismatch { field: "prescribed".into(), detail: format!("node {node} component {c} out of range") });
+            return Err(DemfemError::ShapeMismatch {
+                field: "prescribed".into(),
+                detail: format!("node {node} component {c} out of range"),
+            });
         }
         if !v.is_finite() {
             return Err(DemfemError::invalid("prescribed value", v, "finite"));
@@ -48,17 +59,32 @@ pub fn solve_static(mesh: &TetMesh, material: &LinearElastic, loads: &[[f64; 3]]
     let trips = stiffness_triplets(mesh, &tets, lambda, mu, false);
     let f: Vec<f64> = loads.iter().flatten().cloned().collect();
     let (x, r) = solve_constrained(ndof, &trips, &f, &fixed)?;
-    let to3 = |v: &[f64]| v.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect::<Vec<[f64; 3]>>();
+    let to3 = |v: &[f64]| {
+        v.chunks_exact(3)
+            .map(|c| [c[0], c[1], c[2]])
+            .collect::<Vec<[f64; 3]>>()
+    };
     let (u, reaction) = (to3(&x), to3(&r));
-    Ok(StaticSolution { displacement: u, reaction })
+    Ok(StaticSolution {
+        displacement: u,
+        reaction,
+    })
 }
 
 /// Solve K x = f for a symmetric positive definite K given as full (both triangles)
 /// triplets (row, col, value; duplicates summed) of size `ndof`, with `fixed[d] = Some(v)`
 /// prescribing dof d. Returns (x, reactions K x − f at fixed dofs, 0 elsewhere).
-pub fn solve_constrained(ndof: usize, trips: &[(usize, usize, f64)], f: &[f64], fixed: &[Option<f64>]) -> Result<(Vec<f64>, Vec<f64>)> {
+pub fn solve_constrained(
+    ndof: usize,
+    trips: &[(usize, usize, f64)],
+    f: &[f64],
+    fixed: &[Option<f64>],
+) -> Result<(Vec<f64>, Vec<f64>)> {
     if f.len() != ndof || fixed.len() != ndof {
-        return Err(DemfemError::ShapeMismatch { field: "rhs".into(), detail: format!("expected {ndof} dofs") });
+        return Err(DemfemError::ShapeMismatch {
+            field: "rhs".into(),
+            detail: format!("expected {ndof} dofs"),
+        });
     }
     let mut free_index = vec![usize::MAX; ndof];
     let mut nf = 0;
@@ -77,7 +103,10 @@ pub fn solve_constrained(ndof: usize, trips: &[(usize, usize, f64)], f: &[f64], 
     let mut lower = Vec::with_capacity(trips.len() / 2 + ndof);
     for &(r, c, v) in trips {
         if r >= ndof || c >= ndof {
-            return Err(DemfemError::ShapeMismatch { field: "triplets".into(), detail: format!("index ({r}, {c}) >= {ndof}") });
+            return Err(DemfemError::ShapeMismatch {
+                field: "triplets".into(),
+                detail: format!("index ({r}, {c}) >= {ndof}"),
+            });
         }
         match (free_index[r] != usize::MAX, free_index[c] != usize::MAX) {
             (true, true) if free_index[r] >= free_index[c] => {
@@ -92,16 +121,23 @@ pub fn solve_constrained(ndof: usize, trips: &[(usize, usize, f64)], f: &[f64], 
         }
     }
     if nf > 0 {
-        let k = SparseColMat::<usize, f64>::try_new_from_triplets(nf, nf, &lower)
-            .map_err(|e| DemfemError::Numerical(format!("sparse stiffness assembly failed: {e:?}")))?;
-        let llt = k
-            .sp_cholesky(Side::Lower)
-            .map_err(|e| DemfemError::Numerical(format!("stiffness not positive definite (insufficient supports?): {e:?}")))?;
+        let k = SparseColMat::<usize, f64>::try_new_from_triplets(nf, nf, &lower).map_err(|e| {
+            DemfemError::Numerical(format!("sparse stiffness assembly failed: {e:?}"))
+        })?;
+        let llt = k.sp_cholesky(Side::Lower).map_err(|e| {
+            DemfemError::Numerical(format!(
+                "stiffness not positive definite (insufficient supports?): {e:?}"
+            ))
+        })?;
         llt.solve_in_place(rhs.as_mut());
     }
-    let x: Vec<f64> = (0..ndof).map(|d| fixed[d].unwrap_or_else(|| rhs[(free_index[d], 0)])).collect();
+    let x: Vec<f64> = (0..ndof)
+        .map(|d| fixed[d].unwrap_or_else(|| rhs[(free_index[d], 0)]))
+        .collect();
     if x.iter().any(|v| !v.is_finite()) {
-        return Err(DemfemError::Numerical("static solve produced non-finite displacements".into()));
+        return Err(DemfemError::Numerical(
+            "static solve produced non-finite displacements".into(),
+        ));
     }
     let mut reaction = vec![0.0; ndof];
     for &(r, c, v) in trips {

@@ -11,9 +11,16 @@ use crate::fem::material::LinearElastic;
 use crate::fem::mesh::{signed_volume, TetMesh};
 
 /// Element stresses (Pa) for nodal displacements `u` (m).
-pub fn element_stresses(mesh: &TetMesh, material: &LinearElastic, u: &[[f64; 3]]) -> Result<Vec<[f64; 6]>> {
+pub fn element_stresses(
+    mesh: &TetMesh,
+    material: &LinearElastic,
+    u: &[[f64; 3]],
+) -> Result<Vec<[f64; 6]>> {
     if u.len() != mesh.nodes.len() {
-        return Err(DemfemError::ShapeMismatch { field: "u".into(), detail: format!("{} entries for {} nodes", u.len(), mesh.nodes.len()) });
+        return Err(DemfemError::ShapeMismatch {
+            field: "u".into(),
+            detail: format!("{} entries for {} nodes", u.len(), mesh.nodes.len()),
+        });
     }
     let (lambda, mu) = material.lame();
     let tets = precompute_tets(mesh)?;
@@ -32,12 +39,20 @@ pub fn element_stresses(mesh: &TetMesh, material: &LinearElastic, u: &[[f64; 3]]
 /// weighted by element volume.
 pub fn nodal_stresses(mesh: &TetMesh, element_stress: &[[f64; 6]]) -> Result<Vec<[f64; 6]>> {
     if element_stress.len() != mesh.tets.len() {
-        return Err(DemfemError::ShapeMismatch { field: "element_stress".into(), detail: "one stress per element expected".into() });
+        return Err(DemfemError::ShapeMismatch {
+            field: "element_stress".into(),
+            detail: "one stress per element expected".into(),
+        });
     }
     let mut s = vec![[0.0; 6]; mesh.nodes.len()];
     let mut w = vec![0.0; mesh.nodes.len()];
     for (t, se) in mesh.tets.iter().zip(element_stress) {
-        let v = signed_volume(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]], mesh.nodes[t[3]]);
+        let v = signed_volume(
+            mesh.nodes[t[0]],
+            mesh.nodes[t[1]],
+            mesh.nodes[t[2]],
+            mesh.nodes[t[3]],
+        );
         for &n in t {
             w[n] += v;
             for c in 0..6 {
@@ -69,8 +84,16 @@ pub fn principal_stresses(s: &[f64; 6]) -> [f64; 3] {
     let p2 = (xx - q).powi(2) + (yy - q).powi(2) + (zz - q).powi(2) + 2.0 * p1;
     let p = (p2 / 6.0).sqrt();
     // B = (A − qI)/p, r = det(B)/2.
-    let (bxx, byy, bzz, byz, bxz, bxy) = ((xx - q) / p, (yy - q) / p, (zz - q) / p, yz / p, xz / p, xy / p);
-    let det = bxx * (byy * bzz - byz * byz) - bxy * (bxy * bzz - byz * bxz) + bxz * (bxy * byz - byy * bxz);
+    let (bxx, byy, bzz, byz, bxz, bxy) = (
+        (xx - q) / p,
+        (yy - q) / p,
+        (zz - q) / p,
+        yz / p,
+        xz / p,
+        xy / p,
+    );
+    let det = bxx * (byy * bzz - byz * byz) - bxy * (bxy * bzz - byz * bxz)
+        + bxz * (bxy * byz - byy * bxz);
     let r = (0.5 * det).clamp(-1.0, 1.0);
     let phi = r.acos() / 3.0;
     let e1 = q + 2.0 * p * phi.cos();
@@ -87,7 +110,9 @@ pub fn max_principal_stress(s: &[f64; 6]) -> f64 {
 /// Von Mises equivalent stress, Pa.
 pub fn von_mises(s: &[f64; 6]) -> f64 {
     let (xx, yy, zz, yz, xz, xy) = (s[0], s[1], s[2], s[3], s[4], s[5]);
-    (0.5 * ((xx - yy).powi(2) + (yy - zz).powi(2) + (zz - xx).powi(2)) + 3.0 * (xy * xy + yz * yz + xz * xz)).sqrt()
+    (0.5 * ((xx - yy).powi(2) + (yy - zz).powi(2) + (zz - xx).powi(2))
+        + 3.0 * (xy * xy + yz * yz + xz * xz))
+        .sqrt()
 }
 
 /// A stress sample on a line.
@@ -104,9 +129,18 @@ pub struct LineSample {
 /// Sample the nodal stress field at `n_points` ≥ 2 equally spaced points from `a` to `b`
 /// (m), interpolating linearly inside the containing tetrahedron. Points outside the mesh
 /// (beyond a relative tolerance of 1e-9 in barycentric coordinates) are skipped.
-pub fn stress_along_line(mesh: &TetMesh, nodal_stress: &[[f64; 6]], a: [f64; 3], b: [f64; 3], n_points: usize) -> Result<Vec<LineSample>> {
+pub fn stress_along_line(
+    mesh: &TetMesh,
+    nodal_stress: &[[f64; 6]],
+    a: [f64; 3],
+    b: [f64; 3],
+    n_points: usize,
+) -> Result<Vec<LineSample>> {
     if nodal_stress.len() != mesh.nodes.len() {
-        return Err(DemfemError::ShapeMismatch { field: "nodal_stress".into(), detail: "one stress per node expected".into() });
+        return Err(DemfemError::ShapeMismatch {
+            field: "nodal_stress".into(),
+            detail: "one stress per node expected".into(),
+        });
     }
     if n_points < 2 {
         return Err(DemfemError::invalid("n_points", n_points as f64, ">= 2"));
@@ -115,10 +149,19 @@ pub fn stress_along_line(mesh: &TetMesh, nodal_stress: &[[f64; 6]], a: [f64; 3],
     let mut out = Vec::with_capacity(n_points);
     for k in 0..n_points {
         let s = k as f64 / (n_points - 1) as f64;
-        let p = [a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1]), a[2] + s * (b[2] - a[2])];
+        let p = [
+            a[0] + s * (b[0] - a[0]),
+            a[1] + s * (b[1] - a[1]),
+            a[2] + s * (b[2] - a[2]),
+        ];
         let mut best: Option<(f64, usize, [f64; 4])> = None;
         for (e, t) in mesh.tets.iter().enumerate() {
-            let x = [mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]], mesh.nodes[t[3]]];
+            let x = [
+                mesh.nodes[t[0]],
+                mesh.nodes[t[1]],
+                mesh.nodes[t[2]],
+                mesh.nodes[t[3]],
+            ];
             let v = signed_volume(x[0], x[1], x[2], x[3]);
             let l = [
                 signed_volume(p, x[1], x[2], x[3]) / v,
@@ -143,7 +186,11 @@ pub fn stress_along_line(mesh: &TetMesh, nodal_stress: &[[f64; 6]], a: [f64; 3],
                         st[c] += l[q] * nodal_stress[t[q]][c];
                     }
                 }
-                out.push(LineSample { point: p, distance: s * len, stress: st });
+                out.push(LineSample {
+                    point: p,
+                    distance: s * len,
+                    stress: st,
+                });
             }
         }
     }

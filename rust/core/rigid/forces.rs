@@ -108,6 +108,29 @@ impl ContactModel {
         tangential_displacement: &mut Vector3<f64>,
         dt: f64,
     ) -> Result<Vector3<f64>> {
+        self.force_and_energy(
+            contact,
+            relative_velocity,
+            effective_mass,
+            e_star,
+            tangential_displacement,
+            dt,
+        )
+        .map(|(force, _)| force)
+    }
+
+    /// As [`ContactModel::force`], with the elastic energy stored in the contact after the
+    /// update (J): the Hertz potential 2/5 k_H δ^{5/2} plus the Mindlin spring ½ k_t |ξ|².
+    #[inline]
+    pub fn force_and_energy(
+        &self,
+        contact: &ContactPoint,
+        relative_velocity: &Vector3<f64>,
+        effective_mass: f64,
+        e_star: f64,
+        tangential_displacement: &mut Vector3<f64>,
+        dt: f64,
+    ) -> Result<(Vector3<f64>, f64)> {
         // effective_radius takes a plane (inf) only as its second argument
         let (r1, r2) = if contact.radius_first.is_infinite() {
             (contact.radius_second, contact.radius_first)
@@ -123,6 +146,7 @@ impl ContactModel {
             self.damping_zeta * (effective_mass * k_h).sqrt() * contact.overlap.sqrt().sqrt();
         let normal_force = (elastic - dashpot * normal_speed).max(0.0);
         let mut force = n * normal_force;
+        let mut energy = 0.4 * elastic * contact.overlap;
         if self.friction > 0.0 {
             let slip = relative_velocity - n * normal_speed;
             // turn the old spring into the current tangent plane, keeping its length
@@ -147,9 +171,10 @@ impl ContactModel {
                 };
             }
             *tangential_displacement = turned;
+            energy += 0.5 * k_t * turned.norm_squared();
             force += tangential;
         }
-        Ok(force)
+        Ok((force, energy))
     }
 }
 

@@ -50,7 +50,12 @@ impl ShellTri {
         let e3 = [n[0] / nn, n[1] / nn, n[2] / nn];
         let e2 = cross(e3, e1);
         let local = [[0.0, 0.0], [la, 0.0], [dot(b, e1), dot(b, e2)]];
-        Ok(Self { frame: [e1, e2, e3], local, area: 0.5 * nn, thickness })
+        Ok(Self {
+            frame: [e1, e2, e3],
+            local,
+            area: 0.5 * nn,
+            thickness,
+        })
     }
 
     /// DKT curvature–displacement matrix at area coordinates (ξ, η) = (L2, L3), local dofs
@@ -127,7 +132,8 @@ impl ShellTri {
         for j in 0..9 {
             b[(0, j)] = (y31 * hx_xi[j] + y12 * hx_eta[j]) / two_a;
             b[(1, j)] = (-x31 * hy_xi[j] - x12 * hy_eta[j]) / two_a;
-            b[(2, j)] = (-x31 * hx_xi[j] - x12 * hx_eta[j] + y31 * hy_xi[j] + y12 * hy_eta[j]) / two_a;
+            b[(2, j)] =
+                (-x31 * hx_xi[j] - x12 * hx_eta[j] + y31 * hy_xi[j] + y12 * hy_eta[j]) / two_a;
         }
         b
     }
@@ -150,7 +156,9 @@ impl ShellTri {
     /// (u, v, w, θx, θy, θz), for Young's modulus `e` (Pa) and Poisson ratio `nu`.
     pub fn local_stiffness(&self, e: f64, nu: f64) -> ShellMatrix {
         let h = self.thickness;
-        let plane = SMatrix::<f64, 3, 3>::new(1.0, nu, 0.0, nu, 1.0, 0.0, 0.0, 0.0, 0.5 * (1.0 - nu)) * (e / (1.0 - nu * nu));
+        let plane =
+            SMatrix::<f64, 3, 3>::new(1.0, nu, 0.0, nu, 1.0, 0.0, 0.0, 0.0, 0.5 * (1.0 - nu))
+                * (e / (1.0 - nu * nu));
         let dm = plane * h;
         let db = plane * (h * h * h / 12.0);
         let bm = self.membrane_b();
@@ -178,7 +186,10 @@ impl ShellTri {
         }
         // Drilling: rows sum to zero, so a uniform θz costs nothing.
         // Scaled by the bending *rotation* diagonal terms (N·m), not the w terms (N/m).
-        let kd = DRILLING_FRACTION * (0..3).flat_map(|a| [kb[(3 * a + 1, 3 * a + 1)], kb[(3 * a + 2, 3 * a + 2)]]).fold(0.0, f64::max);
+        let kd = DRILLING_FRACTION
+            * (0..3)
+                .flat_map(|a| [kb[(3 * a + 1, 3 * a + 1)], kb[(3 * a + 2, 3 * a + 2)]])
+                .fold(0.0, f64::max);
         for a in 0..3 {
             for b in 0..3 {
                 k[(6 * a + 5, 6 * b + 5)] = if a == b { kd } else { -0.5 * kd };
@@ -222,7 +233,9 @@ impl ShellTri {
         }
         let em = self.membrane_b() * um;
         let kappa = self.dkt_b(1.0 / 3.0, 1.0 / 3.0) * ub;
-        let plane = SMatrix::<f64, 3, 3>::new(1.0, nu, 0.0, nu, 1.0, 0.0, 0.0, 0.0, 0.5 * (1.0 - nu)) * (e / (1.0 - nu * nu));
+        let plane =
+            SMatrix::<f64, 3, 3>::new(1.0, nu, 0.0, nu, 1.0, 0.0, 0.0, 0.0, 0.5 * (1.0 - nu))
+                * (e / (1.0 - nu * nu));
         let h = self.thickness;
         [-0.5 * h, 0.0, 0.5 * h].map(|z| {
             let s = plane * (em + kappa * z);

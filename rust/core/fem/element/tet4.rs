@@ -30,13 +30,21 @@ impl Tet4 {
     pub fn new(x: [[f64; 3]; 4]) -> Result<Self> {
         let v = signed_volume(x[0], x[1], x[2], x[3]);
         if !(v > 0.0) || !v.is_finite() {
-            return Err(DemfemError::Numerical(format!("tetrahedron with non-positive volume {v:e} m³")));
+            return Err(DemfemError::Numerical(format!(
+                "tetrahedron with non-positive volume {v:e} m³"
+            )));
         }
         // Jacobian columns: edges from node 0. Rows of J⁻¹ are ∇N_1..∇N_3.
         let j = nalgebra::Matrix3::new(
-            x[1][0] - x[0][0], x[2][0] - x[0][0], x[3][0] - x[0][0],
-            x[1][1] - x[0][1], x[2][1] - x[0][1], x[3][1] - x[0][1],
-            x[1][2] - x[0][2], x[2][2] - x[0][2], x[3][2] - x[0][2],
+            x[1][0] - x[0][0],
+            x[2][0] - x[0][0],
+            x[3][0] - x[0][0],
+            x[1][1] - x[0][1],
+            x[2][1] - x[0][1],
+            x[3][1] - x[0][1],
+            x[1][2] - x[0][2],
+            x[2][2] - x[0][2],
+            x[3][2] - x[0][2],
         );
         let jinv = j
             .try_inverse()
@@ -81,7 +89,10 @@ impl Tet4 {
         let mut f = [[0.0; 3]; 4];
         for a in 0..4 {
             for i in 0..3 {
-                f[a][i] = self.volume * (sig[i][0] * self.grads[a][0] + sig[i][1] * self.grads[a][1] + sig[i][2] * self.grads[a][2]);
+                f[a][i] = self.volume
+                    * (sig[i][0] * self.grads[a][0]
+                        + sig[i][1] * self.grads[a][1]
+                        + sig[i][2] * self.grads[a][2]);
             }
         }
         f

@@ -19,7 +19,10 @@ pub struct DataArray<'a> {
 }
 
 fn io_err(path: &Path, e: impl std::fmt::Display) -> DemfemError {
-    DemfemError::Io { path: path.display().to_string(), detail: e.to_string() }
+    DemfemError::Io {
+        path: path.display().to_string(),
+        detail: e.to_string(),
+    }
 }
 
 /// Write `contents` to `path` atomically (temp file in the same directory + rename).
@@ -35,11 +38,19 @@ fn write_array(out: &mut String, a: &DataArray<'_>, n_entries: usize) -> Result<
     if a.n_components == 0 || a.values.len() != n_entries * a.n_components {
         return Err(DemfemError::ShapeMismatch {
             field: a.name.to_string(),
-            detail: format!("{} values for {n_entries} entries × {} components", a.values.len(), a.n_components),
+            detail: format!(
+                "{} values for {n_entries} entries × {} components",
+                a.values.len(),
+                a.n_components
+            ),
         });
     }
     // VTK orders symmetric tensors as XX, YY, ZZ, XY, YZ, XZ; ours are xx,yy,zz,yz,xz,xy.
-    let _ = writeln!(out, r#"        <DataArray type="Float64" Name="{}" NumberOfComponents="{}" format="ascii">"#, a.name, a.n_components);
+    let _ = writeln!(
+        out,
+        r#"        <DataArray type="Float64" Name="{}" NumberOfComponents="{}" format="ascii">"#,
+        a.name, a.n_components
+    );
     for chunk in a.values.chunks(a.n_components) {
         out.push_str("          ");
         let reordered;
@@ -60,13 +71,25 @@ fn write_array(out: &mut String, a: &DataArray<'_>, n_entries: usize) -> Result<
 }
 
 /// Write a tetrahedral mesh with point and cell data to a `.vtu` file.
-pub fn write_vtu(path: &Path, nodes: &[[f64; 3]], tets: &[[usize; 4]], point_data: &[DataArray<'_>], cell_data: &[DataArray<'_>]) -> Result<()> {
+pub fn write_vtu(
+    path: &Path,
+    nodes: &[[f64; 3]],
+    tets: &[[usize; 4]],
+    point_data: &[DataArray<'_>],
+    cell_data: &[DataArray<'_>],
+) -> Result<()> {
     let flat: Vec<usize> = tets.iter().flatten().cloned().collect();
     write_cells(path, nodes, &flat, 4, 10, point_data, cell_data)
 }
 
 /// Write a triangle (shell mid-surface) mesh with point and cell data to a `.vtu` file.
-pub fn write_vtu_triangles(path: &Path, nodes: &[[f64; 3]], triangles: &[[usize; 3]], point_data: &[DataArray<'_>], cell_data: &[DataArray<'_>]) -> Result<()> {
+pub fn write_vtu_triangles(
+    path: &Path,
+    nodes: &[[f64; 3]],
+    triangles: &[[usize; 3]],
+    point_data: &[DataArray<'_>],
+    cell_data: &[DataArray<'_>],
+) -> Result<()> {
     let flat: Vec<usize> = triangles.iter().flatten().cloned().collect();
     write_cells(path, nodes, &flat, 3, 5, point_data, cell_data)
 }
@@ -83,7 +106,12 @@ fn write_cells(
     let n_cells = conn.len() / per_cell;
     let mut s = String::with_capacity(64 * nodes.len() + 64 * n_cells);
     s.push_str("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\">\n  <UnstructuredGrid>\n");
-    let _ = writeln!(s, r#"    <Piece NumberOfPoints="{}" NumberOfCells="{}">"#, nodes.len(), n_cells);
+    let _ = writeln!(
+        s,
+        r#"    <Piece NumberOfPoints="{}" NumberOfCells="{}">"#,
+        nodes.len(),
+        n_cells
+    );
     s.push_str("      <PointData>\n");
     for a in point_data {
         write_array(&mut s, a, nodes.len())?;
@@ -99,7 +127,10 @@ fn write_cells(
     s.push_str("        </DataArray>\n      </Points>\n      <Cells>\n        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n");
     for c in conn.chunks_exact(per_cell) {
         if c.iter().any(|&i| i >= nodes.len()) {
-            return Err(DemfemError::ShapeMismatch { field: "cells".into(), detail: "node index out of range".into() });
+            return Err(DemfemError::ShapeMismatch {
+                field: "cells".into(),
+                detail: "node index out of range".into(),
+            });
         }
         s.push_str("         ");
         for i in c {
@@ -115,7 +146,9 @@ fn write_cells(
     for _ in 0..n_cells {
         let _ = writeln!(s, "          {vtk_type}");
     }
-    s.push_str("        </DataArray>\n      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n");
+    s.push_str(
+        "        </DataArray>\n      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n",
+    );
     write_atomic(path, &s)
 }
 
@@ -136,7 +169,10 @@ impl PvdSeries {
     pub fn write(&self, path: &Path) -> Result<()> {
         let mut s = String::from("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n");
         for (t, f) in &self.entries {
-            let _ = writeln!(s, r#"    <DataSet timestep="{t:e}" group="" part="0" file="{f}"/>"#);
+            let _ = writeln!(
+                s,
+                r#"    <DataSet timestep="{t:e}" group="" part="0" file="{f}"/>"#
+            );
         }
         s.push_str("  </Collection>\n</VTKFile>\n");
         write_atomic(path, &s)

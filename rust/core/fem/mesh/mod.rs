@@ -53,7 +53,11 @@ pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 pub(crate) fn norm(a: [f64; 3]) -> f64 {
     dot(a, a).sqrt()
@@ -85,11 +89,18 @@ impl TetMesh {
                     detail: format!("element {e} refers to a node index >= {n}"),
                 });
             }
-            let v = signed_volume(self.nodes[t[0]], self.nodes[t[1]], self.nodes[t[2]], self.nodes[t[3]]);
+            let v = signed_volume(
+                self.nodes[t[0]],
+                self.nodes[t[1]],
+                self.nodes[t[2]],
+                self.nodes[t[3]],
+            );
             if !(v > 0.0) {
                 return Err(DemfemError::ShapeMismatch {
                     field: "mesh.tets".into(),
-                    detail: format!("element {e} has non-positive volume {v:e} m³ (inverted or degenerate)"),
+                    detail: format!(
+                        "element {e} has non-positive volume {v:e} m³ (inverted or degenerate)"
+                    ),
                 });
             }
         }
@@ -104,7 +115,12 @@ impl TetMesh {
         let mut flipped = 0;
         for t in self.tets.iter_mut() {
             if t.iter().all(|&i| i < self.nodes.len())
-                && signed_volume(self.nodes[t[0]], self.nodes[t[1]], self.nodes[t[2]], self.nodes[t[3]]) < 0.0
+                && signed_volume(
+                    self.nodes[t[0]],
+                    self.nodes[t[1]],
+                    self.nodes[t[2]],
+                    self.nodes[t[3]],
+                ) < 0.0
             {
                 t.swap(2, 3);
                 flipped += 1;
@@ -127,7 +143,14 @@ impl TetMesh {
     pub fn volume(&self) -> f64 {
         self.tets
             .iter()
-            .map(|t| signed_volume(self.nodes[t[0]], self.nodes[t[1]], self.nodes[t[2]], self.nodes[t[3]]))
+            .map(|t| {
+                signed_volume(
+                    self.nodes[t[0]],
+                    self.nodes[t[1]],
+                    self.nodes[t[2]],
+                    self.nodes[t[3]],
+                )
+            })
             .sum()
     }
 
@@ -143,7 +166,10 @@ impl TetMesh {
         if !(q.min_dihedral_deg >= min_dihedral_deg) {
             return Err(DemfemError::InvalidParameter {
                 field: "mesh".into(),
-                value: format!("min dihedral angle {:.3}° at element {}", q.min_dihedral_deg, q.worst_element),
+                value: format!(
+                    "min dihedral angle {:.3}° at element {}",
+                    q.min_dihedral_deg, q.worst_element
+                ),
                 allowed: format!("no sliver elements: every dihedral angle >= {min_dihedral_deg}°"),
             });
         }
@@ -191,7 +217,11 @@ impl TriMesh {
         if self.triangles.len() != self.thickness.len() {
             return Err(DemfemError::ShapeMismatch {
                 field: "thickness".into(),
-                detail: format!("{} values for {} triangles", self.thickness.len(), self.triangles.len()),
+                detail: format!(
+                    "{} values for {} triangles",
+                    self.thickness.len(),
+                    self.triangles.len()
+                ),
             });
         }
         let n = self.nodes.len();
@@ -202,7 +232,10 @@ impl TriMesh {
                     detail: format!("triangle {e} refers to a node index >= {n}"),
                 });
             }
-            let a = norm(cross(sub(self.nodes[t[1]], self.nodes[t[0]]), sub(self.nodes[t[2]], self.nodes[t[0]])));
+            let a = norm(cross(
+                sub(self.nodes[t[1]], self.nodes[t[0]]),
+                sub(self.nodes[t[2]], self.nodes[t[0]]),
+            ));
             if !(a > 0.0) || !(self.thickness[e] > 0.0) || !self.thickness[e].is_finite() {
                 return Err(DemfemError::ShapeMismatch {
                     field: "triangles".into(),
@@ -217,7 +250,12 @@ impl TriMesh {
     pub fn area(&self) -> f64 {
         self.triangles
             .iter()
-            .map(|t| 0.5 * norm(cross(sub(self.nodes[t[1]], self.nodes[t[0]]), sub(self.nodes[t[2]], self.nodes[t[0]]))))
+            .map(|t| {
+                0.5 * norm(cross(
+                    sub(self.nodes[t[1]], self.nodes[t[0]]),
+                    sub(self.nodes[t[2]], self.nodes[t[0]]),
+                ))
+            })
             .sum()
     }
 
@@ -226,7 +264,13 @@ impl TriMesh {
         self.triangles
             .iter()
             .zip(&self.thickness)
-            .map(|(t, h)| 0.5 * h * norm(cross(sub(self.nodes[t[1]], self.nodes[t[0]]), sub(self.nodes[t[2]], self.nodes[t[0]]))))
+            .map(|(t, h)| {
+                0.5 * h
+                    * norm(cross(
+                        sub(self.nodes[t[1]], self.nodes[t[0]]),
+                        sub(self.nodes[t[2]], self.nodes[t[0]]),
+                    ))
+            })
             .sum()
     }
 

@@ -37,8 +37,14 @@ pub struct MeshQuality {
 
 /// Dihedral angles and aspect ratio of the tetrahedron with vertices `x`.
 pub fn tet_quality(x: [[f64; 3]; 4]) -> TetQuality {
-    const EDGES: [(usize, usize, usize, usize); 6] =
-        [(0, 1, 2, 3), (0, 2, 1, 3), (0, 3, 1, 2), (1, 2, 0, 3), (1, 3, 0, 2), (2, 3, 0, 1)];
+    const EDGES: [(usize, usize, usize, usize); 6] = [
+        (0, 1, 2, 3),
+        (0, 2, 1, 3),
+        (0, 3, 1, 2),
+        (1, 2, 0, 3),
+        (1, 3, 0, 2),
+        (2, 3, 0, 1),
+    ];
     let mut dmin = 180.0f64;
     let mut dmax = 0.0f64;
     let mut lmax = 0.0f64;
@@ -49,10 +55,28 @@ pub fn tet_quality(x: [[f64; 3]; 4]) -> TetQuality {
         let en = [e[0] / le, e[1] / le, e[2] / le];
         let pc = sub(x[c], x[a]);
         let pd = sub(x[d], x[a]);
-        let u = sub(pc, [en[0] * dot(pc, en), en[1] * dot(pc, en), en[2] * dot(pc, en)]);
-        let w = sub(pd, [en[0] * dot(pd, en), en[1] * dot(pd, en), en[2] * dot(pd, en)]);
+        let u = sub(
+            pc,
+            [
+                en[0] * dot(pc, en),
+                en[1] * dot(pc, en),
+                en[2] * dot(pc, en),
+            ],
+        );
+        let w = sub(
+            pd,
+            [
+                en[0] * dot(pd, en),
+                en[1] * dot(pd, en),
+                en[2] * dot(pd, en),
+            ],
+        );
         let c = (dot(u, w) / (norm(u) * norm(w))).clamp(-1.0, 1.0);
-        let ang = if c.is_finite() { c.acos().to_degrees() } else { 0.0 };
+        let ang = if c.is_finite() {
+            c.acos().to_degrees()
+        } else {
+            0.0
+        };
         dmin = dmin.min(ang);
         dmax = dmax.max(ang);
     }
@@ -60,8 +84,17 @@ pub fn tet_quality(x: [[f64; 3]; 4]) -> TetQuality {
     let area = |a: usize, b: usize, c: usize| 0.5 * norm(cross(sub(x[b], x[a]), sub(x[c], x[a])));
     let total_area = area(1, 2, 3) + area(0, 2, 3) + area(0, 1, 3) + area(0, 1, 2);
     let inradius = 3.0 * v.abs() / total_area;
-    let aspect = if inradius > 0.0 { lmax / (2.0 * 6f64.sqrt() * inradius) } else { f64::INFINITY };
-    TetQuality { min_dihedral_deg: dmin, max_dihedral_deg: dmax, aspect_ratio: aspect, volume: v }
+    let aspect = if inradius > 0.0 {
+        lmax / (2.0 * 6f64.sqrt() * inradius)
+    } else {
+        f64::INFINITY
+    };
+    TetQuality {
+        min_dihedral_deg: dmin,
+        max_dihedral_deg: dmax,
+        aspect_ratio: aspect,
+        volume: v,
+    }
 }
 
 impl MeshQuality {

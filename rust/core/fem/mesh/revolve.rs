@@ -52,9 +52,18 @@ impl AxisymmetricProfile {
     pub fn default_cartridge() -> Self {
         let mm = 1e-3;
         Self {
-            z: [0.0, 54.5, 58.5, 61.0, 61.3, 64.0].iter().map(|v| v * mm).collect(),
-            r_in: [4.7, 4.7, 1.9, 1.9, 1.9, 1.9].iter().map(|v| v * mm).collect(),
-            r_out: [5.8, 5.8, 3.0, 3.0, 3.65, 3.65].iter().map(|v| v * mm).collect(),
+            z: [0.0, 54.5, 58.5, 61.0, 61.3, 64.0]
+                .iter()
+                .map(|v| v * mm)
+                .collect(),
+            r_in: [4.7, 4.7, 1.9, 1.9, 1.9, 1.9]
+                .iter()
+                .map(|v| v * mm)
+                .collect(),
+            r_out: [5.8, 5.8, 3.0, 3.0, 3.65, 3.65]
+                .iter()
+                .map(|v| v * mm)
+                .collect(),
         }
     }
 
@@ -83,7 +92,11 @@ impl AxisymmetricProfile {
             }
             check_positive("r_in", self.r_in[k])?;
             if !(self.r_out[k] > self.r_in[k]) || !self.r_out[k].is_finite() {
-                return Err(DemfemError::invalid("r_out", self.r_out[k], "finite and > r_in at the same station"));
+                return Err(DemfemError::invalid(
+                    "r_out",
+                    self.r_out[k],
+                    "finite and > r_in at the same station",
+                ));
             }
             if k > 0 && !(self.z[k] > self.z[k - 1]) {
                 return Err(DemfemError::invalid("z", self.z[k], "strictly increasing"));
@@ -112,7 +125,12 @@ impl AxisymmetricProfile {
     /// `n_layers` through the wall, axial divisions from `target_size` (m). Each hexahedral
     /// cell is split into six tets (Kuhn subdivision), giving a conforming mesh.
     /// Fails for `n_theta < 3`, `n_layers < 1`, a non-positive size, or inverted cells.
-    pub fn tet_mesh(&self, n_theta: usize, n_layers: usize, target_size: f64) -> Result<RevolvedTetMesh> {
+    pub fn tet_mesh(
+        &self,
+        n_theta: usize,
+        n_layers: usize,
+        target_size: f64,
+    ) -> Result<RevolvedTetMesh> {
         self.validate()?;
         check_positive("target_size", target_size)?;
         if n_theta < 3 {
@@ -145,7 +163,12 @@ impl AxisymmetricProfile {
         }
         let mesh = TetMesh { nodes, tets };
         mesh.validate()?;
-        Ok(RevolvedTetMesh { mesh, n_theta, n_layers, z_stations: stations.iter().map(|s| s.0).collect() })
+        Ok(RevolvedTetMesh {
+            mesh,
+            n_theta,
+            n_layers,
+            z_stations: stations.iter().map(|s| s.0).collect(),
+        })
     }
 
     /// Mid-surface shell mesh of flat triangles: nodes on r_mid = (r_in + r_out)/2,
@@ -190,7 +213,11 @@ impl AxisymmetricProfile {
                 thickness.push(t);
             }
         }
-        let m = TriMesh { nodes, triangles, thickness };
+        let m = TriMesh {
+            nodes,
+            triangles,
+            thickness,
+        };
         m.validate()?;
         Ok(m)
     }
@@ -198,8 +225,19 @@ impl AxisymmetricProfile {
 
 /// Split one structured hexahedral cell into six positively oriented tetrahedra along its
 /// (0,0,0)–(1,1,1) index diagonal. `corner` maps an index offset to a node index.
-fn kuhn_split(corner: &dyn Fn([usize; 3]) -> usize, nodes: &[[f64; 3]], tets: &mut Vec<[usize; 4]>) -> Result<()> {
-    const PERMS: [[usize; 3]; 6] = [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]];
+fn kuhn_split(
+    corner: &dyn Fn([usize; 3]) -> usize,
+    nodes: &[[f64; 3]],
+    tets: &mut Vec<[usize; 4]>,
+) -> Result<()> {
+    const PERMS: [[usize; 3]; 6] = [
+        [0, 1, 2],
+        [0, 2, 1],
+        [1, 0, 2],
+        [1, 2, 0],
+        [2, 0, 1],
+        [2, 1, 0],
+    ];
     for p in PERMS {
         let mut c = [0usize; 3];
         let mut t = [corner(c); 4];
@@ -211,7 +249,9 @@ fn kuhn_split(corner: &dyn Fn([usize; 3]) -> usize, nodes: &[[f64; 3]], tets: &m
         if v < 0.0 {
             t.swap(2, 3);
         } else if v == 0.0 || !v.is_finite() {
-            return Err(DemfemError::Numerical(format!("degenerate cell while meshing (tet volume {v:e} m³)")));
+            return Err(DemfemError::Numerical(format!(
+                "degenerate cell while meshing (tet volume {v:e} m³)"
+            )));
         }
         tets.push(t);
     }
@@ -225,13 +265,21 @@ pub fn box_tet_mesh(lx: f64, ly: f64, lz: f64, nx: usize, ny: usize, nz: usize) 
     check_positive("ly", ly)?;
     check_positive("lz", lz)?;
     if nx == 0 || ny == 0 || nz == 0 {
-        return Err(DemfemError::invalid("nx*ny*nz", (nx * ny * nz) as f64, "every division >= 1"));
+        return Err(DemfemError::invalid(
+            "nx*ny*nz",
+            (nx * ny * nz) as f64,
+            "every division >= 1",
+        ));
     }
     let mut nodes = Vec::with_capacity((nx + 1) * (ny + 1) * (nz + 1));
     for k in 0..=nz {
         for j in 0..=ny {
             for i in 0..=nx {
-                nodes.push([lx * i as f64 / nx as f64, ly * j as f64 / ny as f64, lz * k as f64 / nz as f64]);
+                nodes.push([
+                    lx * i as f64 / nx as f64,
+                    ly * j as f64 / ny as f64,
+                    lz * k as f64 / nz as f64,
+                ]);
             }
         }
     }
