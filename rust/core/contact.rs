@@ -165,8 +165,13 @@ pub fn hertz_reissner_root(s: f64) -> f64 {
         return s.cbrt() - 1.0 / 3.0;
     }
     let r2 = s.sqrt();
-    let r3 = s.cbrt();
-    let m = r2.min((r3 - 1.0 / 3.0).max(0.75 * r3));
+    // √s ≤ 0.75 ∛s for s ≤ 0.75⁶ = 0.178: below that the min is √s and ∛s is not needed
+    let m = if s <= 0.17 {
+        r2
+    } else {
+        let r3 = s.cbrt();
+        r2.min((r3 - 1.0 / 3.0).max(0.75 * r3))
+    };
     let mut u = (s / (1.0 + m)).sqrt();
     for _ in 0..2 {
         // Halley on g(u) = u²(u + 1) − s: u −= g g' / (g'² − g g''/2)

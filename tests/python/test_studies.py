@@ -217,6 +217,31 @@ def test_coordination_findings_measure_a_known_oscillation():
     assert f["q05"] == pytest.approx(4.0, abs=0.05) and f["q95"] == pytest.approx(6.0, abs=0.05)
 
 
+def test_speed_windows_average_a_known_ramp():
+    t = np.arange(0, 20.0 + 1e-9, 0.05)
+    v = 0.01 * t  # m/s
+    v[t >= 15.0] = np.nan  # the sphere has left
+    w = figures.speed_windows(t, v, 10.0)
+    assert len(w) == 2
+    # window [0, 10): t = 0 ... 9.95, mean 4.975 s -> 49.75 mm/s, peak 99.5 mm/s
+    assert w[0]["mean_mm_s"] == pytest.approx(49.75) and w[0]["peak_mm_s"] == pytest.approx(99.5)
+    assert w[0]["finite_fraction"] == 1.0
+    # window [10, 20): finite for t = 10 ... 14.95 only
+    assert w[1]["mean_mm_s"] == pytest.approx(124.75) and w[1]["finite_fraction"] == 0.5
+    with pytest.raises(InvalidParameterError, match="width"):
+        figures.speed_windows(t, v, 0.0)
+
+
+def test_per_modulus_durations_override_and_are_checked():
+    opts = figures.StudyOptions(out=".", duration=8.0, moduli=(1e7, 1e8, 4.5e10))
+    assert figures._durations(opts, 4.0, {1e7: 60.0}) == {1e7: 60.0, 1e8: 8.0, 4.5e10: 4.0}
+    assert figures._durations(opts, None, {4.5e10: 12.0}) == {1e7: 8.0, 1e8: 8.0, 4.5e10: 12.0}
+    with pytest.raises(InvalidParameterError, match="durations key E = 1000000000.0"):
+        figures._durations(opts, None, {1e9: 5.0})
+    with pytest.raises(InvalidParameterError, match=r"durations\[10000000.0\] = -1"):
+        figures._durations(opts, None, {1e7: -1.0})
+
+
 def test_study_options_and_cli_errors(capsys):
     with pytest.raises(InvalidParameterError, match="duration"):
         figures.StudyOptions(out=".", duration=0.0, moduli=(1e7,))
@@ -224,6 +249,10 @@ def test_study_options_and_cli_errors(capsys):
         figures.StudyOptions(out=".", duration=1.0, moduli=())
     assert main(["fig6", "--E", "ten", "--quick"]) == 2
     assert "invalid --E 'ten'" in capsys.readouterr().err
+    assert main(["fig7", "--E-duration", "1e7:60", "--quick"]) == 2
+    assert "invalid --E-duration '1e7:60'" in capsys.readouterr().err
+    assert main(["fig7", "--E", "1e7", "--E-duration", "1e8=60", "--quick"]) == 2
+    assert "invalid durations key E = 100000000.0" in capsys.readouterr().err
 
 
 @pytest.mark.slow

@@ -18,7 +18,7 @@ import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Optional, Sequence
+from typing import Any, Callable, Mapping, Optional, Sequence
 
 import matplotlib
 
@@ -48,6 +48,7 @@ __all__ = [
     "fig6",
     "fig7",
     "fig8_9",
+    "speed_windows",
 ]
 
 #: Table parameters shared by all studies (one geometry for the whole A sweep).
@@ -213,17 +214,36 @@ def _format_ranking(ranking: np.ndarray, part: str, seen: dict, discard_before: 
 # Figs. 6 and 7
 # --------------------------------------------------------------------------------------------
 
-def _durations(opts: StudyOptions, long_modulus_duration: Optional[float]) -> dict[float, float]:
-    """``opts.duration`` for every E, or ``long_modulus_duration`` for E > 1e9 Pa if given
-    (the stiff runs cost ~E^0.4 more steps per simulated second)."""
-    return {e: (long_modulus_duration if long_modulus_duration and e > 1e9 else opts.duration)
-            for e in opts.moduli}
+def _durations(opts: StudyOptions, long_modulus_duration: Optional[float],
+               per_modulus: Optional[Mapping[float, float]] = None) -> dict[float, float]:
+    """Simulated time per E, s: ``per_modulus[E]`` where given, else ``long_modulus_duration``
+    for E > 1e9 Pa if given (the stiff runs cost ~E^0.4 more steps per simulated second),
+    else ``opts.duration``. Every key of ``per_modulus`` must be one of ``opts.moduli``."""
+    per = dict(per_modulus or {})
+    for e, d in per.items():
+        if not any(math.isclose(float(e), m, rel_tol=1e-12) for m in opts.moduli):
+            raise InvalidParameterError(
+                f"invalid durations key E = {e!r} Pa: must be one of the moduli "
+                f"{tuple(opts.moduli)} Pa")
+        if not (isinstance(d, (int, float)) and math.isfinite(d) and d > 0):
+            raise InvalidParameterError(
+                f"invalid durations[{e!r}] = {d!r}: must be a finite simulated time > 0 s")
+
+    def duration(e: float) -> float:
+        for k, d in per.items():
+            if math.isclose(float(k), e, rel_tol=1e-12):
+                return float(d)
+        return (long_modulus_duration if long_modulus_duration and e > 1e9
+                else opts.duration)
+
+    return {e: duration(e) for e in opts.moduli}
 
 
-def _run_all_moduli(opts: StudyOptions, stiff_duration: Optional[float]
+def _run_all_moduli(opts: StudyOptions, stiff_duration: Optional[float],
+                    durations_by_modulus: Optional[Mapping[float, float]] = None
                     ) -> list[tuple[float, TableRun]]:
     """All E runs in one sweep per duration group (so two run at once)."""
-    durations = _durations(opts, stiff_duration)
+    durations = _durations(opts, stiff_duration, durations_by_modulus)
     runs: dict[float, TableRun] = {}
     for duration in sorted(set(durations.values())):
         es = [e for e in opts.moduli if durations[e] == duration]
@@ -251,9 +271,12 @@ def coordination_findings(times: np.ndarray, z: np.ndarray, period: float,
 
 
 def fig6(opts: StudyOptions, stiff_duration: Optional[float] = None,
-         discard_before: float = 2.0) -> dict[str, Any]:
+         discard_before: float = 2.0,
+         durations: Optional[Mapping[float, float]] = None) -> dict[str, Any]:
     """Fig. 6: coordination number against time for each E in ``opts.moduli`` (all spheres,
-    first line, rectangular centre), V_belt = 0.1 m/s, T = 2 s, A = 2 cm.
+    first line, rectangular centre), V_belt = 0.1 m/s, T = 2 s, A = 2 cm. Each run lasts
+    ``durations[E]`` s where given, else ``stiff_duration`` s for E > 1e9 Pa if given, else
+    ``opts.duration`` s.
 
     Tests the paper's claims on the recording: the period of each curve after
     ``discard_before`` s (:func:`period_of_oscillation`) against T, the range (5-95 %
@@ -261,7 +284,7 @@ def fig6(opts: StudyOptions, stiff_duration: Optional[float] = None,
     between the all-sphere mean coordination at any E and at the smallest E, over the common
     time span. Writes ``fig6_coordination.png`` and ``fig6_findings.json``.
     """
-    runs = _run_all_moduli(opts, stiff_duration)
+    runs = _run_all_moduli(opts, stiff_duration, durations)
     groups = (("all spheres", None), ("first line", Tag.FIRST_LINE),
               ("rectangular centre", Tag.RECTANGULAR_CENTRE))
     findings: dict[str, Any] = {"setup": FIG6_SETUP, "moduli_Pa": list(opts.moduli),
@@ -317,24 +340,57 @@ def _format_fig6(f: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
-def fig7(opts: StudyOptions, stiff_duration: Optional[float] = None) -> dict[str, Any]:
-    """Fig. 7: speed of the rectangular centre against time for each E (same runs as Fig. 6),
-    panel (a) E <= 1e9 Pa, (b) E > 1e9 Pa. Writes ``fig7_rectangular_centre_speed.png`` and
-    ``fig7_findings.json`` (mean and peak speed per E over each run, and over its last 2 s)."""
-    runs = _run_all_moduli(opts, stiff_duration)
+def speed_windows(times: np.ndarray, speed: np.ndarray, width: float) -> list[dict[str, float]]:
+    """Mean and peak of ``speed`` (m/s, NaN once the sphere has left) over consecutive windows
+    of ``width`` s from t = 0, in mm/s, with the fraction of each window's samples that are
+    finite; windows with no finite sample are left out."""
+    if not (math.isfinite(width) and width > 0):
+        raise InvalidParameterError(f"invalid width = {width!r}: must be a finite time > 0 s")
+    out = []
+    t_end = float(times[-1]) if len(times) else 0.0
+    k = 0
+    while k * width < t_end - 1e-9:
+        sel = (times >= k * width) & (times < (k + 1) * width)
+        v = speed[sel]
+        ok = np.isfinite(v)
+        if ok.any():
+            out.append({"t0_s": k * width, "t1_s": min((k + 1) * width, t_end),
+                        "mean_mm_s": float(1e3 * np.mean(v[ok])),
+                        "peak_mm_s": float(1e3 * np.max(v[ok])),
+                        "finite_fraction": float(ok.mean())})
+        k += 1
+    return out
+
+
+def fig7(opts: StudyOptions, stiff_duration: Optional[float] = None,
+         durations: Optional[Mapping[float, float]] = None,
+         window: float = 10.0) -> dict[str, Any]:
+    """Fig. 7: speed of the rectangular centre against time for each E (same runs as Fig. 6;
+    durations as there), panel (a) E <= 1e9 Pa, (b) E > 1e9 Pa. Writes
+    ``fig7_rectangular_centre_speed.png`` and ``fig7_findings.json``: per E the mean and peak
+    speed over the run, over its last 2 s and per ``window`` s (:func:`speed_windows`), the
+    time the sphere left the table (None if it did not), and the belt's free-rolling speed
+    2/7 V_belt for comparison, all speeds in mm/s."""
+    runs = _run_all_moduli(opts, stiff_duration, durations)
     fig, axes = plt.subplots(2, 1, figsize=(8, 7), sharex=True)
     findings: dict[str, Any] = {}
     for e, run in runs:
         s = tagged_speed(run.velocities, run.tags, Tag.RECTANGULAR_CENTRE)
         ax = axes[0] if e <= 1e9 else axes[1]
-        ax.plot(run.times, 1e3 * s, lw=0.9, label=_e_label(e))
+        ax.plot(run.times, 1e3 * s, lw=0.7, label=_e_label(e))
         late = run.times >= run.times[-1] - 2.0
+        gone = np.flatnonzero(np.isnan(s))
         findings[f"{e:.3g}"] = {
             "duration_s": float(run.times[-1]),
             "mean_speed_mm_s": float(1e3 * np.nanmean(s)),
             "peak_speed_mm_s": float(1e3 * np.nanmax(s)),
-            "mean_speed_last_2s_mm_s": float(1e3 * np.nanmean(s[late])),
+            "mean_speed_last_2s_mm_s": (float(1e3 * np.nanmean(s[late]))
+                                        if np.isfinite(s[late]).any() else None),
             "removed": bool(np.isnan(s[-1])),
+            "left_at_s": float(run.times[gone[0]]) if gone.size else None,
+            "windows": speed_windows(run.times, s, window),
+            "n_removed": int(np.isfinite(run.removal_times).sum()),
+            "free_rolling_mm_s": 1e3 * 2.0 / 7.0 * FIG6_SETUP["belt_velocity"],
         }
     for ax, title in zip(axes, ("(a) E <= 1e9 Pa", "(b) E > 1e9 Pa")):
         ax.set_title(title, fontsize="medium")
@@ -350,7 +406,8 @@ def fig7(opts: StudyOptions, stiff_duration: Optional[float] = None) -> dict[str
     write_text_atomic(opts.out / "fig7_findings.json", json.dumps(findings, indent=1) + "\n")
     opts.log("Fig. 7 findings (rectangular centre speed):\n" + "\n".join(
         f"  E={e:>8} Pa, {v['duration_s']:g} s: mean {v['mean_speed_mm_s']:.1f} mm/s, peak "
-        f"{v['peak_speed_mm_s']:.1f} mm/s, last 2 s {v['mean_speed_last_2s_mm_s']:.1f} mm/s"
+        f"{v['peak_speed_mm_s']:.1f} mm/s, left at {v['left_at_s']} s; per {window:g} s: "
+        + ", ".join(f"{w['mean_mm_s']:.0f}/{w['peak_mm_s']:.0f}" for w in v["windows"])
         for e, v in findings.items()))
     return findings
 
