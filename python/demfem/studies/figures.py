@@ -346,10 +346,15 @@ def speed_windows(times: np.ndarray, speed: np.ndarray, width: float) -> list[di
     finite; windows with no finite sample are left out."""
     if not (math.isfinite(width) and width > 0):
         raise InvalidParameterError(f"invalid width = {width!r}: must be a finite time > 0 s")
-    out = []
-    t_end = float(times[-1]) if len(times) else 0.0
+    out: list[dict[str, float]] = []
+    if len(times) == 0:
+        return out
+    t_end = float(times[-1])
+    # a run ends on the first step at or after its last sample time: no window for that
+    # overshoot, only for whole sample intervals
+    half = 0.5 * float(np.median(np.diff(times))) if len(times) > 1 else 0.0
     k = 0
-    while k * width < t_end - 1e-9:
+    while k * width < t_end - half:
         sel = (times >= k * width) & (times < (k + 1) * width)
         v = speed[sel]
         ok = np.isfinite(v)
