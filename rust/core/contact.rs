@@ -131,10 +131,11 @@ impl NormalLaw {
             NormalLaw::HertzReissner { k_h, k_r } => {
                 // the limits of an unvalidated law: no shell is Hertz, a rigid ball the spring
                 if k_r.is_infinite() {
-                    return NormalLaw::Hertz { k_h }.force_and_stiffness(overlap);
+                    let s = overlap.sqrt();
+                    return (k_h * overlap * s, 1.5 * k_h * s);
                 }
                 if k_h.is_infinite() {
-                    return NormalLaw::Linear { k: k_r }.force_and_stiffness(overlap);
+                    return (k_r * overlap, k_r);
                 }
                 let (f, k, _) = HertzReissnerScaled::new_unchecked(k_h, k_r).evaluate(overlap);
                 (f, k)
