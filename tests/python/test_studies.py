@@ -232,6 +232,21 @@ def test_speed_windows_average_a_known_ramp():
         figures.speed_windows(t, v, 0.0)
 
 
+def test_discharge_speeds_follow_mass_conservation():
+    # 10 spheres leave in [0, 10) s and 30 in [10, 20): Q = 1 and 3 per s
+    removal = np.concatenate([np.linspace(0.5, 9.5, 10), np.linspace(10.1, 19.9, 30),
+                              [np.nan, np.nan]])
+    w = figures.discharge_speeds(removal, 20.0, 10.0, table_width=0.5, pitch=0.02,
+                                 opening_width=0.05, belt_velocity=0.1)
+    assert [x["discharge_per_s"] for x in w] == [1.0, 3.0]
+    # v = Q p^2 / W = 3 * 4e-4 / 0.5 m/s = 2.4 mm/s (square), x sqrt(3)/2 (hexagonal)
+    assert w[1]["bulk_speed_square_mm_s"] == pytest.approx(2.4)
+    assert w[1]["bulk_speed_hexagonal_mm_s"] == pytest.approx(2.4 * 3 ** 0.5 / 2)
+    assert w[0]["bulk_speed_bound_mm_s"] == pytest.approx(10.0)  # 0.1 * 0.05 / 0.5 m/s
+    with pytest.raises(InvalidParameterError, match="pitch"):
+        figures.discharge_speeds(removal, 20.0, 10.0, 0.5, 0.0, 0.05, 0.1)
+
+
 def test_per_modulus_durations_override_and_are_checked():
     opts = figures.StudyOptions(out=".", duration=8.0, moduli=(1e7, 1e8, 4.5e10))
     assert figures._durations(opts, 4.0, {1e7: 60.0}) == {1e7: 60.0, 1e8: 8.0, 4.5e10: 4.0}

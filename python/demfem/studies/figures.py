@@ -49,6 +49,7 @@ __all__ = [
     "fig7",
     "fig8_9",
     "speed_windows",
+    "discharge_speeds",
 ]
 
 #: Table parameters shared by all studies (one geometry for the whole A sweep).
@@ -367,6 +368,37 @@ def speed_windows(times: np.ndarray, speed: np.ndarray, width: float) -> list[di
     return out
 
 
+def discharge_speeds(removal_times: np.ndarray, t_end: float, width: float,
+                     table_width: float, pitch: float, opening_width: float,
+                     belt_velocity: float) -> list[dict[str, float]]:
+    """What mass conservation allows the bulk of the rectangular section to move at.
+
+    Per consecutive window of ``width`` s up to ``t_end``: the discharge Q (spheres/s through
+    the opening, from ``removal_times``, s) and the mean speed of a pack of table width W
+    (``table_width``, m) that feeds it, v = Q a / W, with a the area of one sphere in the
+    layer, between hexagonal (√3/2 p²) and square (p²) packing of pitch p (``pitch``, m);
+    and the bound V_belt w̄ / W that holds even if the spheres left at the belt speed through
+    the mean opening w̄ (``opening_width``, m), filling it. Speeds in mm/s."""
+    for name, value in (("width", width), ("table_width", table_width), ("pitch", pitch),
+                        ("opening_width", opening_width), ("belt_velocity", belt_velocity)):
+        if not (math.isfinite(value) and value > 0):
+            raise InvalidParameterError(f"invalid {name} = {value!r}: must be finite and > 0")
+    done = np.asarray(removal_times, float)
+    done = done[np.isfinite(done)]
+    out = []
+    k = 0
+    while k * width < t_end - 1e-9:
+        t0, t1 = k * width, min((k + 1) * width, t_end)
+        q = float(np.count_nonzero((done >= t0) & (done < t1))) / (t1 - t0)
+        out.append({"t0_s": t0, "t1_s": t1, "discharge_per_s": q,
+                    "bulk_speed_hexagonal_mm_s": 1e3 * q * math.sqrt(3) / 2 * pitch ** 2
+                    / table_width,
+                    "bulk_speed_square_mm_s": 1e3 * q * pitch ** 2 / table_width,
+                    "bulk_speed_bound_mm_s": 1e3 * belt_velocity * opening_width / table_width})
+        k += 1
+    return out
+
+
 def fig7(opts: StudyOptions, stiff_duration: Optional[float] = None,
          durations: Optional[Mapping[float, float]] = None,
          window: float = 10.0) -> dict[str, Any]:
@@ -374,8 +406,9 @@ def fig7(opts: StudyOptions, stiff_duration: Optional[float] = None,
     durations as there), panel (a) E <= 1e9 Pa, (b) E > 1e9 Pa. Writes
     ``fig7_rectangular_centre_speed.png`` and ``fig7_findings.json``: per E the mean and peak
     speed over the run, over its last 2 s and per ``window`` s (:func:`speed_windows`), the
-    time the sphere left the table (None if it did not), and the belt's free-rolling speed
-    2/7 V_belt for comparison, all speeds in mm/s."""
+    time the sphere left the table (None if it did not), the belt's free-rolling speed
+    2/7 V_belt, and per window the discharge and the bulk speed it implies
+    (:func:`discharge_speeds`), all speeds in mm/s."""
     runs = _run_all_moduli(opts, stiff_duration, durations)
     fig, axes = plt.subplots(2, 1, figsize=(8, 7), sharex=True)
     findings: dict[str, Any] = {}
@@ -394,6 +427,13 @@ def fig7(opts: StudyOptions, stiff_duration: Optional[float] = None,
             "removed": bool(np.isnan(s[-1])),
             "left_at_s": float(run.times[gone[0]]) if gone.size else None,
             "windows": speed_windows(run.times, s, window),
+            "continuity": discharge_speeds(
+                run.removal_times, float(run.times[-1]), window,
+                float(run.parameters["width"]),
+                2.0 * float(run.parameters["sphere_radius"])
+                * (1.0 + float(run.parameters["packing_gap"])),
+                float(run.parameters["opening_width"]),
+                float(run.parameters["belt_velocity"])),
             "n_removed": int(np.isfinite(run.removal_times).sum()),
             "free_rolling_mm_s": 1e3 * 2.0 / 7.0 * FIG6_SETUP["belt_velocity"],
         }
