@@ -387,7 +387,9 @@ def discharge_speeds(removal_times: np.ndarray, t_end: float, width: float,
     done = done[np.isfinite(done)]
     out = []
     k = 0
-    while k * width < t_end - 1e-9:
+    # no window for the overshoot of the last step past the last sample (a run ends on the
+    # first step at or after it): a window must span at least 1 % of `width`
+    while k * width < t_end - 0.01 * width:
         t0, t1 = k * width, min((k + 1) * width, t_end)
         q = float(np.count_nonzero((done >= t0) & (done < t1))) / (t1 - t0)
         out.append({"t0_s": t0, "t1_s": t1, "discharge_per_s": q,
@@ -415,7 +417,15 @@ def fig7(opts: StudyOptions, stiff_duration: Optional[float] = None,
     for e, run in runs:
         s = tagged_speed(run.velocities, run.tags, Tag.RECTANGULAR_CENTRE)
         ax = axes[0] if e <= 1e9 else axes[1]
-        ax.plot(run.times, 1e3 * s, lw=0.7, label=_e_label(e))
+        # the samples, faint, and their 2 s running mean
+        (line,) = ax.plot(run.times, 1e3 * s, lw=0.5, alpha=0.35)
+        n_avg = max(1, int(round(2.0 / float(np.median(np.diff(run.times))))))
+        kernel = np.ones(n_avg) / n_avg
+        smooth = np.convolve(np.nan_to_num(s), kernel, mode="same") / np.convolve(
+            np.isfinite(s).astype(float), kernel, mode="same").clip(1e-12)
+        smooth[~np.isfinite(s)] = np.nan
+        ax.plot(run.times, 1e3 * smooth, lw=1.3, color=line.get_color(),
+                label=f"{_e_label(e)} (2 s mean)")
         late = run.times >= run.times[-1] - 2.0
         gone = np.flatnonzero(np.isnan(s))
         findings[f"{e:.3g}"] = {
@@ -441,6 +451,8 @@ def fig7(opts: StudyOptions, stiff_duration: Optional[float] = None,
         ax.set_title(title, fontsize="medium")
         ax.set_ylabel("speed (mm/s)")
         if ax.lines:
+            ax.axhline(1e3 * 2.0 / 7.0 * FIG6_SETUP["belt_velocity"], color="grey", ls=":",
+                       lw=0.8, label="2/7 V_belt (free rolling)")
             ax.legend(fontsize="small")
     axes[-1].set_xlabel("time (s)")
     fig.suptitle("Fig. 7 analogue: rectangular-centre speed, V_belt = 0.1 m/s, T = 2 s, "
