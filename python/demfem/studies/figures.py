@@ -419,7 +419,7 @@ def fig7(opts: StudyOptions, stiff_duration: Optional[float] = None,
         ax = axes[0] if e <= 1e9 else axes[1]
         # the samples, faint, and their 2 s running mean
         (line,) = ax.plot(run.times, 1e3 * s, lw=0.5, alpha=0.35)
-        n_avg = max(1, int(round(2.0 / float(np.median(np.diff(run.times))))))
+        n_avg = max(1, min(len(s), int(round(2.0 / float(np.median(np.diff(run.times)))))))
         kernel = np.ones(n_avg) / n_avg
         smooth = np.convolve(np.nan_to_num(s), kernel, mode="same") / np.convolve(
             np.isfinite(s).astype(float), kernel, mode="same").clip(1e-12)
