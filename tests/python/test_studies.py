@@ -257,6 +257,27 @@ def test_per_modulus_durations_override_and_are_checked():
         figures._durations(opts, None, {1e7: -1.0})
 
 
+def test_coordination_period_survives_a_draining_trend():
+    # the table drains: a fall from 3 to 1 over 60 s under the 2 s gate oscillation
+    t = np.arange(0, 60, 0.05)
+    z = 3.0 - t / 30.0 + 0.5 * np.sin(2 * np.pi * t / 2.0)
+    f = figures.coordination_findings(t, z, 2.0, discard_before=2.0)
+    assert f["period_acf_s"] == pytest.approx(2.0, rel=0.02)
+    assert f["period_fft_s"] == pytest.approx(2.0, rel=0.02)
+
+
+def test_moving_average_is_nan_aware_and_exact_on_lines():
+    x = np.arange(10.0)
+    m = figures.moving_average(x, 3)
+    assert np.allclose(m[1:-1], x[1:-1]) and m[0] == 0.5 and m[-1] == 8.5
+    y = x.copy()
+    y[4] = np.nan
+    assert figures.moving_average(y, 3)[4] == 4.0  # mean of 3 and 5
+    assert np.isnan(figures.moving_average(np.full(4, np.nan), 3)).all()
+    with pytest.raises(InvalidParameterError, match="invalid n"):
+        figures.moving_average(x, 0)
+
+
 def test_study_options_and_cli_errors(capsys):
     with pytest.raises(InvalidParameterError, match="duration"):
         figures.StudyOptions(out=".", duration=0.0, moduli=(1e7,))

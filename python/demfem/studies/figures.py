@@ -50,6 +50,7 @@ __all__ = [
     "fig8_9",
     "speed_windows",
     "discharge_speeds",
+    "moving_average",
 ]
 
 #: Table parameters shared by all studies (one geometry for the whole A sweep).
@@ -255,18 +256,41 @@ def _run_all_moduli(opts: StudyOptions, stiff_duration: Optional[float],
     return [(float(e), runs[float(e)]) for e in opts.moduli]
 
 
+def moving_average(x: np.ndarray, n: int) -> np.ndarray:
+    """Centred running mean of ``x`` over ``n`` samples, NaN-aware: each output averages the
+    finite samples of its window (fewer at the ends); NaN where the window has none."""
+    if not (isinstance(n, (int, np.integer)) and n >= 1):
+        raise InvalidParameterError(f"invalid n = {n!r}: must be a whole number of samples >= 1")
+    x = np.asarray(x, float)
+    n = min(int(n), len(x)) if len(x) else 1
+    kernel = np.ones(n)
+    finite = np.isfinite(x)
+    total = np.convolve(np.where(finite, x, 0.0), kernel, mode="same")
+    count = np.convolve(finite.astype(float), kernel, mode="same")
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(count > 0, total / np.where(count > 0, count, 1.0), np.nan)
+
+
 def coordination_findings(times: np.ndarray, z: np.ndarray, period: float,
                           discard_before: float) -> dict[str, float]:
     """Numbers behind "oscillates between 4 and 6 with period T": the measured period
     (autocorrelation and FFT, s), and the 5 % and 95 % quantiles of ``z`` after
-    ``discard_before`` s, with the gate period T for comparison."""
+    ``discard_before`` s, with the gate period T for comparison.
+
+    The period is measured on ``z`` minus its running mean over one gate period
+    (:func:`moving_average`): that removes what is slower than T — the fall of the
+    coordination while the table drains, which dominates long records — and leaves a
+    T-periodic part unchanged (its mean over a whole period is zero). The quantiles are
+    those of ``z`` itself."""
     keep = times >= discard_before
     t, x = times[keep], z[keep]
     if len(t) < 8:
         return {"period_acf_s": math.nan, "period_fft_s": math.nan, "q05": math.nan,
                 "q95": math.nan, "gate_period_s": period}
-    return {"period_acf_s": period_of_oscillation(t, x, "autocorrelation"),
-            "period_fft_s": period_of_oscillation(t, x, "fft"),
+    step = float(np.median(np.diff(t)))
+    fast = x - moving_average(x, max(1, int(round(period / step))))
+    return {"period_acf_s": period_of_oscillation(t, fast, "autocorrelation"),
+            "period_fft_s": period_of_oscillation(t, fast, "fft"),
             "q05": float(np.nanquantile(x, 0.05)), "q95": float(np.nanquantile(x, 0.95)),
             "gate_period_s": period}
 
@@ -419,10 +443,7 @@ def fig7(opts: StudyOptions, stiff_duration: Optional[float] = None,
         ax = axes[0] if e <= 1e9 else axes[1]
         # the samples, faint, and their 2 s running mean
         (line,) = ax.plot(run.times, 1e3 * s, lw=0.5, alpha=0.35)
-        n_avg = max(1, min(len(s), int(round(2.0 / float(np.median(np.diff(run.times)))))))
-        kernel = np.ones(n_avg) / n_avg
-        smooth = np.convolve(np.nan_to_num(s), kernel, mode="same") / np.convolve(
-            np.isfinite(s).astype(float), kernel, mode="same").clip(1e-12)
+        smooth = moving_average(s, max(1, int(round(2.0 / float(np.median(np.diff(run.times)))))))
         smooth[~np.isfinite(s)] = np.nan
         ax.plot(run.times, 1e3 * smooth, lw=1.3, color=line.get_color(),
                 label=f"{_e_label(e)} (2 s mean)")
