@@ -89,8 +89,8 @@ pub(crate) struct ContactConst {
     f_el: f64,
     /// Hertz: 8 G* √R*; Hertz–Reissner: 8 G* √R* k_R/k_H, N/m; linear: k_t, N/m.
     k_t: f64,
-    /// Hertz: ζ √(4/3 m* E* √R*); Hertz–Reissner: ζ √(2/3 m* k_R); linear:
-    /// β √(m* k_n), all N·s/m (times the powers of s or u above).
+    /// Hertz: ζ √(4/3 m* E* √R*); Hertz–Reissner: ζ √(2/3 m* k_R); linear: 2β √(m* k_n)
+    /// (the pair law's `linear_damping` = 2β); N·s/m times the powers of s or u above.
     c_n: f64,
     /// c_t / c_n.
     ct_ratio: f64,
