@@ -14,9 +14,10 @@ Run:  python examples/fig6_coordination.py [--duration 8] [--E 1e7,1e8,1e9]
 """
 import sys
 
-from demfem.cli import build_parser, study_options_from_args
+from demfem.cli import build_parser, durations_from_args, study_options_from_args
 from demfem.studies.figures import fig6
 
 if __name__ == "__main__":
     args = build_parser().parse_args(["fig6", *sys.argv[1:]])
-    fig6(study_options_from_args(args), stiff_duration=args.stiff_duration)
+    fig6(study_options_from_args(args), stiff_duration=args.stiff_duration,
+         durations=durations_from_args(args))

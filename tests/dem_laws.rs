@@ -134,3 +134,106 @@ fn rolling_resistance_decelerates_at_five_sevenths_mu_r_g() {
         "v = {v}, expected {expected}"
     );
 }
+
+/// Velocity samples of one sphere resting on a rigid floor under gravity after a small kick
+/// `kick` (m/s) from its Hertz–Reissner equilibrium, with the given effects and step.
+fn hr_oscillation(
+    k_r: f64,
+    kick: Vec3,
+    effects: EffectSet,
+    dt: f64,
+    steps: usize,
+) -> (f64, Vec<Vec3>, Simulation) {
+    let (e, nu, rho, r, g) = (45e9, 0.22, 2230.0, 0.008, 9.81);
+    let m = sphere_mass(rho, r);
+    let k_h = k_hertz(e_star(e, nu, 1e21, nu), r);
+    let f0 = m * g;
+    let delta0 = (f0 / k_h).powf(2.0 / 3.0) + f0 / k_r; // eq. 12 at rest
+    // the scene refuses friction or restitution < 1 without the effect that uses it
+    let mu = if effects.has(Effect::Friction) { 0.5 } else { 0.0 };
+    let rest = if effects.has(Effect::Damping) { 0.5 } else { 1.0 };
+    let mut mat = material(e, nu, rho, mu, rest);
+    mat.shell_stiffness = k_r;
+    let floor = rigid(nu, mu, rest);
+    let mut scene = sphere_on_floor(r, r - delta0, kick, Vec3::ZERO, vec![mat, floor], effects);
+    scene.model = ContactModel::HertzReissnerMindlin;
+    scene.gravity = Vec3::new(0.0, 0.0, -g);
+    scene.time_step = Some(dt);
+    let mut sim = Simulation::new(&scene).unwrap();
+    let mut v = Vec::with_capacity(steps);
+    for _ in 0..steps {
+        sim.step(1).unwrap();
+        v.push(sim.velocities()[0]);
+    }
+    (m, v, sim)
+}
+
+/// Mean spacing of the downward zero crossings of `x` (linear interpolation), in samples.
+fn mean_period(x: &[f64]) -> f64 {
+    let crossings: Vec<f64> = (1..x.len())
+        .filter(|&i| x[i - 1] > 0.0 && x[i] <= 0.0)
+        .map(|i| (i - 1) as f64 + x[i - 1] / (x[i - 1] - x[i]))
+        .collect();
+    assert!(crossings.len() >= 4, "too few periods: {}", crossings.len());
+    (crossings[crossings.len() - 1] - crossings[0]) / (crossings.len() - 1) as f64
+}
+
+/// Small oscillations of a sphere resting on a rigid floor under the Hertz–Reissner–Mindlin
+/// law, against the linearised law at F₀ = m g (shell chosen so Hertz and shell overlaps are
+/// comparable, s ≈ 1): normal period 2π √(m/k_n) with k_n = dF/dδ =
+/// 1/((2/3) F₀^{-1/3} k_H^{-2/3} + 1/k_R); tangential period 2π √(m/k_t) with the Mindlin
+/// k_t = 8 G* √(R δ_H), δ_H = (F₀/k_H)^{2/3} (rotation off, far below the Coulomb cap); and
+/// with damping the decay of the normal velocity over one damped period, exp(−γ T_d),
+/// γ = c_n/(2m), c_n = ζ √(2/3 m k_n) (Tsuji, ζ of the scene's restitution 0.5 with the force
+/// clamp). Amplitudes are 1e-3 of the static overlap, so the nonlinearity is ~1e-6; dt is
+/// 1/2000 of a period (1/8000 for the decay). Tolerances: periods 1e-4; decay rate 1.5e-3,
+/// because the dashpot reads the half-step velocity, an O(γ dt) error (2.5e-3 at T/2000,
+/// 6.5e-4 at T/8000).
+#[test]
+fn hertz_reissner_mindlin_small_oscillations_match_linearised_law() {
+    let (e, nu, r, g, k_r) = (45e9, 0.22_f64, 0.008, 9.81, 1.0e6);
+    let k_h = k_hertz(e_star(e, nu, 1e21, nu), r);
+    let m = sphere_mass(2230.0, r);
+    let f0 = m * g;
+    let d_h = (f0 / k_h).powf(2.0 / 3.0);
+    let delta0 = d_h + f0 / k_r;
+    let k_n = 1.0 / (2.0 / 3.0 / (f0 * k_h * k_h).cbrt() + 1.0 / k_r);
+    let shear = |e: f64, nu: f64| e / (2.0 * (1.0 + nu));
+    let g_star = 1.0 / ((2.0 - nu) / shear(e, nu) + (2.0 - nu) / shear(1e21, nu));
+    let k_t = 8.0 * g_star * (r * d_h).sqrt();
+    let (t_n, t_t) = (
+        2.0 * std::f64::consts::PI * (m / k_n).sqrt(),
+        2.0 * std::f64::consts::PI * (m / k_t).sqrt(),
+    );
+
+    // normal, undamped
+    let omega_n = 2.0 * std::f64::consts::PI / t_n;
+    let kick = Vec3::new(0.0, 0.0, -1e-3 * delta0 * omega_n);
+    let dt = t_n / 2000.0;
+    let (_, v, _) = hr_oscillation(k_r, kick, EffectSet::of(&[Effect::Gravity]), dt, 20_000);
+    let vz: Vec<f64> = v.iter().map(|v| v.z).collect();
+    let period = mean_period(&vz) * dt;
+    assert!((period / t_n - 1.0).abs() < 1e-4, "normal period {period} vs {t_n}");
+
+    // tangential, undamped, no rotation
+    let omega_t = 2.0 * std::f64::consts::PI / t_t;
+    let kick = Vec3::new(1e-3 * delta0 * omega_t, 0.0, 0.0);
+    let dt = t_t / 2000.0;
+    let effects = EffectSet::of(&[Effect::Gravity, Effect::Friction]);
+    let (_, v, _) = hr_oscillation(k_r, kick, effects, dt, 20_000);
+    let vx: Vec<f64> = v.iter().map(|v| v.x).collect();
+    let period = mean_period(&vx) * dt;
+    assert!((period / t_t - 1.0).abs() < 1e-4, "tangential period {period} vs {t_t}");
+
+    // normal, damped: v(t + T_d) = v(t) exp(−γ T_d)
+    let zeta = demfem::contact::tsuji_damping_for_restitution(0.5, demfem::contact::ForceClamp::NonNegative).unwrap();
+    let c_n = zeta * (2.0 / 3.0 * m * k_n).sqrt();
+    let gamma = c_n / (2.0 * m);
+    let t_d = 2.0 * std::f64::consts::PI / (omega_n * omega_n - gamma * gamma).sqrt();
+    let dt = t_d / 8000.0;
+    let kick = Vec3::new(0.0, 0.0, -1e-3 * delta0 * omega_n);
+    let effects = EffectSet::of(&[Effect::Gravity, Effect::Damping]);
+    let (_, v, _) = hr_oscillation(k_r, kick, effects, dt, 10_000);
+    let measured = (v[8_800].z / v[800].z).ln() / -t_d;
+    assert!((measured / gamma - 1.0).abs() < 1.5e-3, "decay rate {measured} vs {gamma}");
+}

@@ -7,7 +7,7 @@ from typing import Optional, Sequence
 
 import numpy as np
 
-from demfem.errors import DemfemError
+from demfem.errors import DemfemError, InvalidParameterError
 
 __all__ = ["main", "build_parser", "study_options_from_args"]
 
@@ -89,6 +89,24 @@ def study_options_from_args(args: argparse.Namespace):
                         workers=args.workers)
 
 
+def durations_from_args(args: argparse.Namespace) -> dict[float, float]:
+    """Per-modulus durations of `demfem fig6|fig7 --E-duration E=SECONDS ...` as
+    {E (Pa): simulated time (s)}."""
+    out: dict[float, float] = {}
+    for item in getattr(args, "E_duration", None) or []:
+        e_text, sep, d_text = item.partition("=")
+        try:
+            if not sep:
+                raise ValueError
+            e, d = float(e_text), float(d_text)
+        except ValueError:
+            raise InvalidParameterError(
+                f"invalid --E-duration {item!r}: must be E=SECONDS, Young's modulus in Pa and "
+                "simulated time in s, e.g. 1e7=60") from None
+        out[e] = d
+    return out
+
+
 def _cmd_study(args: argparse.Namespace) -> int:
     from demfem.studies import figures
 
@@ -97,9 +115,11 @@ def _cmd_study(args: argparse.Namespace) -> int:
         result = figures.fig5(opts, discard_before=args.discard_before)
         print(f"gentlest set-up: {result['gentlest']} (paper: A=2cm T=2s V=0.2m/s)")
     elif args.command == "fig6":
-        figures.fig6(opts, stiff_duration=args.stiff_duration)
+        figures.fig6(opts, stiff_duration=args.stiff_duration,
+                     durations=durations_from_args(args))
     elif args.command == "fig7":
-        figures.fig7(opts, stiff_duration=args.stiff_duration)
+        figures.fig7(opts, stiff_duration=args.stiff_duration,
+                     durations=durations_from_args(args))
     else:
         figures.fig8_9(opts, snapshot_times=tuple(float(x) for x in args.snapshots.split(",")))
     print(f"figures in {opts.out}")
@@ -169,6 +189,9 @@ def build_parser() -> argparse.ArgumentParser:
         f.add_argument("--stiff-duration", type=float, default=None,
                        help="simulated time for the runs with E > 1e9 Pa, s (default: "
                             "--duration)")
+        f.add_argument("--E-duration", action="append", default=None, metavar="E=SECONDS",
+                       help="simulated time for the run at E (Pa), s, over --duration and "
+                            "--stiff-duration; repeat for more, e.g. --E-duration 1e7=60")
     f8 = _add_study(sub, "fig8", "Figs. 8-9: triangular centre and first line, snapshots, GIF "
                     "and ParaView series")
     f8.add_argument("--snapshots", default="9.3,12.2", metavar="T1,T2,...",

@@ -217,6 +217,67 @@ def test_coordination_findings_measure_a_known_oscillation():
     assert f["q05"] == pytest.approx(4.0, abs=0.05) and f["q95"] == pytest.approx(6.0, abs=0.05)
 
 
+def test_speed_windows_average_a_known_ramp():
+    t = np.arange(0, 20.0 + 1e-9, 0.05)
+    v = 0.01 * t  # m/s
+    v[t >= 15.0] = np.nan  # the sphere has left
+    w = figures.speed_windows(t, v, 10.0)
+    assert len(w) == 2
+    # window [0, 10): t = 0 ... 9.95, mean 4.975 s -> 49.75 mm/s, peak 99.5 mm/s
+    assert w[0]["mean_mm_s"] == pytest.approx(49.75) and w[0]["peak_mm_s"] == pytest.approx(99.5)
+    assert w[0]["finite_fraction"] == 1.0
+    # window [10, 20): finite for t = 10 ... 14.95 only
+    assert w[1]["mean_mm_s"] == pytest.approx(124.75) and w[1]["finite_fraction"] == 0.5
+    with pytest.raises(InvalidParameterError, match="width"):
+        figures.speed_windows(t, v, 0.0)
+
+
+def test_discharge_speeds_follow_mass_conservation():
+    # 10 spheres leave in [0, 10) s and 30 in [10, 20): Q = 1 and 3 per s
+    removal = np.concatenate([np.linspace(0.5, 9.5, 10), np.linspace(10.1, 19.9, 30),
+                              [np.nan, np.nan]])
+    w = figures.discharge_speeds(removal, 20.0, 10.0, table_width=0.5, pitch=0.02,
+                                 opening_width=0.05, belt_velocity=0.1)
+    assert [x["discharge_per_s"] for x in w] == [1.0, 3.0]
+    # v = Q p^2 / W = 3 * 4e-4 / 0.5 m/s = 2.4 mm/s (square), x sqrt(3)/2 (hexagonal)
+    assert w[1]["bulk_speed_square_mm_s"] == pytest.approx(2.4)
+    assert w[1]["bulk_speed_hexagonal_mm_s"] == pytest.approx(2.4 * 3 ** 0.5 / 2)
+    assert w[0]["bulk_speed_bound_mm_s"] == pytest.approx(10.0)  # 0.1 * 0.05 / 0.5 m/s
+    with pytest.raises(InvalidParameterError, match="pitch"):
+        figures.discharge_speeds(removal, 20.0, 10.0, 0.5, 0.0, 0.05, 0.1)
+
+
+def test_per_modulus_durations_override_and_are_checked():
+    opts = figures.StudyOptions(out=".", duration=8.0, moduli=(1e7, 1e8, 4.5e10))
+    assert figures._durations(opts, 4.0, {1e7: 60.0}) == {1e7: 60.0, 1e8: 8.0, 4.5e10: 4.0}
+    assert figures._durations(opts, None, {4.5e10: 12.0}) == {1e7: 8.0, 1e8: 8.0, 4.5e10: 12.0}
+    with pytest.raises(InvalidParameterError, match="durations key E = 1000000000.0"):
+        figures._durations(opts, None, {1e9: 5.0})
+    with pytest.raises(InvalidParameterError, match=r"durations\[10000000.0\] = -1"):
+        figures._durations(opts, None, {1e7: -1.0})
+
+
+def test_coordination_period_survives_a_draining_trend():
+    # the table drains: a fall from 3 to 1 over 60 s under the 2 s gate oscillation
+    t = np.arange(0, 60, 0.05)
+    z = 3.0 - t / 30.0 + 0.5 * np.sin(2 * np.pi * t / 2.0)
+    f = figures.coordination_findings(t, z, 2.0, discard_before=2.0)
+    assert f["period_acf_s"] == pytest.approx(2.0, rel=0.02)
+    assert f["period_fft_s"] == pytest.approx(2.0, rel=0.02)
+
+
+def test_moving_average_is_nan_aware_and_exact_on_lines():
+    x = np.arange(10.0)
+    m = figures.moving_average(x, 3)
+    assert np.allclose(m[1:-1], x[1:-1]) and m[0] == 0.5 and m[-1] == 8.5
+    y = x.copy()
+    y[4] = np.nan
+    assert figures.moving_average(y, 3)[4] == 4.0  # mean of 3 and 5
+    assert np.isnan(figures.moving_average(np.full(4, np.nan), 3)).all()
+    with pytest.raises(InvalidParameterError, match="invalid n"):
+        figures.moving_average(x, 0)
+
+
 def test_study_options_and_cli_errors(capsys):
     with pytest.raises(InvalidParameterError, match="duration"):
         figures.StudyOptions(out=".", duration=0.0, moduli=(1e7,))
@@ -224,6 +285,10 @@ def test_study_options_and_cli_errors(capsys):
         figures.StudyOptions(out=".", duration=1.0, moduli=())
     assert main(["fig6", "--E", "ten", "--quick"]) == 2
     assert "invalid --E 'ten'" in capsys.readouterr().err
+    assert main(["fig7", "--E-duration", "1e7:60", "--quick"]) == 2
+    assert "invalid --E-duration '1e7:60'" in capsys.readouterr().err
+    assert main(["fig7", "--E", "1e7", "--E-duration", "1e8=60", "--quick"]) == 2
+    assert "invalid durations key E = 100000000.0" in capsys.readouterr().err
 
 
 @pytest.mark.slow

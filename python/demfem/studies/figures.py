@@ -18,7 +18,7 @@ import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Optional, Sequence
+from typing import Any, Callable, Mapping, Optional, Sequence
 
 import matplotlib
 
@@ -48,6 +48,9 @@ __all__ = [
     "fig6",
     "fig7",
     "fig8_9",
+    "speed_windows",
+    "discharge_speeds",
+    "moving_average",
 ]
 
 #: Table parameters shared by all studies (one geometry for the whole A sweep).
@@ -213,17 +216,36 @@ def _format_ranking(ranking: np.ndarray, part: str, seen: dict, discard_before: 
 # Figs. 6 and 7
 # --------------------------------------------------------------------------------------------
 
-def _durations(opts: StudyOptions, long_modulus_duration: Optional[float]) -> dict[float, float]:
-    """``opts.duration`` for every E, or ``long_modulus_duration`` for E > 1e9 Pa if given
-    (the stiff runs cost ~E^0.4 more steps per simulated second)."""
-    return {e: (long_modulus_duration if long_modulus_duration and e > 1e9 else opts.duration)
-            for e in opts.moduli}
+def _durations(opts: StudyOptions, long_modulus_duration: Optional[float],
+               per_modulus: Optional[Mapping[float, float]] = None) -> dict[float, float]:
+    """Simulated time per E, s: ``per_modulus[E]`` where given, else ``long_modulus_duration``
+    for E > 1e9 Pa if given (the stiff runs cost ~E^0.4 more steps per simulated second),
+    else ``opts.duration``. Every key of ``per_modulus`` must be one of ``opts.moduli``."""
+    per = dict(per_modulus or {})
+    for e, d in per.items():
+        if not any(math.isclose(float(e), m, rel_tol=1e-12) for m in opts.moduli):
+            raise InvalidParameterError(
+                f"invalid durations key E = {e!r} Pa: must be one of the moduli "
+                f"{tuple(opts.moduli)} Pa")
+        if not (isinstance(d, (int, float)) and math.isfinite(d) and d > 0):
+            raise InvalidParameterError(
+                f"invalid durations[{e!r}] = {d!r}: must be a finite simulated time > 0 s")
+
+    def duration(e: float) -> float:
+        for k, d in per.items():
+            if math.isclose(float(k), e, rel_tol=1e-12):
+                return float(d)
+        return (long_modulus_duration if long_modulus_duration and e > 1e9
+                else opts.duration)
+
+    return {e: duration(e) for e in opts.moduli}
 
 
-def _run_all_moduli(opts: StudyOptions, stiff_duration: Optional[float]
+def _run_all_moduli(opts: StudyOptions, stiff_duration: Optional[float],
+                    durations_by_modulus: Optional[Mapping[float, float]] = None
                     ) -> list[tuple[float, TableRun]]:
     """All E runs in one sweep per duration group (so two run at once)."""
-    durations = _durations(opts, stiff_duration)
+    durations = _durations(opts, stiff_duration, durations_by_modulus)
     runs: dict[float, TableRun] = {}
     for duration in sorted(set(durations.values())):
         es = [e for e in opts.moduli if durations[e] == duration]
@@ -234,26 +256,52 @@ def _run_all_moduli(opts: StudyOptions, stiff_duration: Optional[float]
     return [(float(e), runs[float(e)]) for e in opts.moduli]
 
 
+def moving_average(x: np.ndarray, n: int) -> np.ndarray:
+    """Centred running mean of ``x`` over ``n`` samples, NaN-aware: each output averages the
+    finite samples of its window (fewer at the ends); NaN where the window has none."""
+    if not (isinstance(n, (int, np.integer)) and n >= 1):
+        raise InvalidParameterError(f"invalid n = {n!r}: must be a whole number of samples >= 1")
+    x = np.asarray(x, float)
+    n = min(int(n), len(x)) if len(x) else 1
+    kernel = np.ones(n)
+    finite = np.isfinite(x)
+    total = np.convolve(np.where(finite, x, 0.0), kernel, mode="same")
+    count = np.convolve(finite.astype(float), kernel, mode="same")
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(count > 0, total / np.where(count > 0, count, 1.0), np.nan)
+
+
 def coordination_findings(times: np.ndarray, z: np.ndarray, period: float,
                           discard_before: float) -> dict[str, float]:
     """Numbers behind "oscillates between 4 and 6 with period T": the measured period
     (autocorrelation and FFT, s), and the 5 % and 95 % quantiles of ``z`` after
-    ``discard_before`` s, with the gate period T for comparison."""
+    ``discard_before`` s, with the gate period T for comparison.
+
+    The period is measured on ``z`` minus its running mean over one gate period
+    (:func:`moving_average`): that removes what is slower than T — the fall of the
+    coordination while the table drains, which dominates long records — and leaves a
+    T-periodic part unchanged (its mean over a whole period is zero). The quantiles are
+    those of ``z`` itself."""
     keep = times >= discard_before
     t, x = times[keep], z[keep]
     if len(t) < 8:
         return {"period_acf_s": math.nan, "period_fft_s": math.nan, "q05": math.nan,
                 "q95": math.nan, "gate_period_s": period}
-    return {"period_acf_s": period_of_oscillation(t, x, "autocorrelation"),
-            "period_fft_s": period_of_oscillation(t, x, "fft"),
+    step = float(np.median(np.diff(t)))
+    fast = x - moving_average(x, max(1, int(round(period / step))))
+    return {"period_acf_s": period_of_oscillation(t, fast, "autocorrelation"),
+            "period_fft_s": period_of_oscillation(t, fast, "fft"),
             "q05": float(np.nanquantile(x, 0.05)), "q95": float(np.nanquantile(x, 0.95)),
             "gate_period_s": period}
 
 
 def fig6(opts: StudyOptions, stiff_duration: Optional[float] = None,
-         discard_before: float = 2.0) -> dict[str, Any]:
+         discard_before: float = 2.0,
+         durations: Optional[Mapping[float, float]] = None) -> dict[str, Any]:
     """Fig. 6: coordination number against time for each E in ``opts.moduli`` (all spheres,
-    first line, rectangular centre), V_belt = 0.1 m/s, T = 2 s, A = 2 cm.
+    first line, rectangular centre), V_belt = 0.1 m/s, T = 2 s, A = 2 cm. Each run lasts
+    ``durations[E]`` s where given, else ``stiff_duration`` s for E > 1e9 Pa if given, else
+    ``opts.duration`` s.
 
     Tests the paper's claims on the recording: the period of each curve after
     ``discard_before`` s (:func:`period_of_oscillation`) against T, the range (5-95 %
@@ -261,7 +309,7 @@ def fig6(opts: StudyOptions, stiff_duration: Optional[float] = None,
     between the all-sphere mean coordination at any E and at the smallest E, over the common
     time span. Writes ``fig6_coordination.png`` and ``fig6_findings.json``.
     """
-    runs = _run_all_moduli(opts, stiff_duration)
+    runs = _run_all_moduli(opts, stiff_duration, durations)
     groups = (("all spheres", None), ("first line", Tag.FIRST_LINE),
               ("rectangular centre", Tag.RECTANGULAR_CENTRE))
     findings: dict[str, Any] = {"setup": FIG6_SETUP, "moduli_Pa": list(opts.moduli),
@@ -317,29 +365,115 @@ def _format_fig6(f: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
-def fig7(opts: StudyOptions, stiff_duration: Optional[float] = None) -> dict[str, Any]:
-    """Fig. 7: speed of the rectangular centre against time for each E (same runs as Fig. 6),
-    panel (a) E <= 1e9 Pa, (b) E > 1e9 Pa. Writes ``fig7_rectangular_centre_speed.png`` and
-    ``fig7_findings.json`` (mean and peak speed per E over each run, and over its last 2 s)."""
-    runs = _run_all_moduli(opts, stiff_duration)
+def speed_windows(times: np.ndarray, speed: np.ndarray, width: float) -> list[dict[str, float]]:
+    """Mean and peak of ``speed`` (m/s, NaN once the sphere has left) over consecutive windows
+    of ``width`` s from t = 0, in mm/s, with the fraction of each window's samples that are
+    finite; windows with no finite sample are left out."""
+    if not (math.isfinite(width) and width > 0):
+        raise InvalidParameterError(f"invalid width = {width!r}: must be a finite time > 0 s")
+    out: list[dict[str, float]] = []
+    if len(times) == 0:
+        return out
+    t_end = float(times[-1])
+    # a run ends on the first step at or after its last sample time: no window for that
+    # overshoot, only for whole sample intervals
+    half = 0.5 * float(np.median(np.diff(times))) if len(times) > 1 else 0.0
+    k = 0
+    while k * width < t_end - half:
+        sel = (times >= k * width) & (times < (k + 1) * width)
+        v = speed[sel]
+        ok = np.isfinite(v)
+        if ok.any():
+            out.append({"t0_s": k * width, "t1_s": min((k + 1) * width, t_end),
+                        "mean_mm_s": float(1e3 * np.mean(v[ok])),
+                        "peak_mm_s": float(1e3 * np.max(v[ok])),
+                        "finite_fraction": float(ok.mean())})
+        k += 1
+    return out
+
+
+def discharge_speeds(removal_times: np.ndarray, t_end: float, width: float,
+                     table_width: float, pitch: float, opening_width: float,
+                     belt_velocity: float) -> list[dict[str, float]]:
+    """What mass conservation allows the bulk of the rectangular section to move at.
+
+    Per consecutive window of ``width`` s up to ``t_end``: the discharge Q (spheres/s through
+    the opening, from ``removal_times``, s) and the mean speed of a pack of table width W
+    (``table_width``, m) that feeds it, v = Q a / W, with a the area of one sphere in the
+    layer, between hexagonal (√3/2 p²) and square (p²) packing of pitch p (``pitch``, m);
+    and the bound V_belt w̄ / W that holds even if the spheres left at the belt speed through
+    the mean opening w̄ (``opening_width``, m), filling it. Speeds in mm/s."""
+    for name, value in (("width", width), ("table_width", table_width), ("pitch", pitch),
+                        ("opening_width", opening_width), ("belt_velocity", belt_velocity)):
+        if not (math.isfinite(value) and value > 0):
+            raise InvalidParameterError(f"invalid {name} = {value!r}: must be finite and > 0")
+    done = np.asarray(removal_times, float)
+    done = done[np.isfinite(done)]
+    out = []
+    k = 0
+    # no window for the overshoot of the last step past the last sample (a run ends on the
+    # first step at or after it): a window must span at least 1 % of `width`
+    while k * width < t_end - 0.01 * width:
+        t0, t1 = k * width, min((k + 1) * width, t_end)
+        q = float(np.count_nonzero((done >= t0) & (done < t1))) / (t1 - t0)
+        out.append({"t0_s": t0, "t1_s": t1, "discharge_per_s": q,
+                    "bulk_speed_hexagonal_mm_s": 1e3 * q * math.sqrt(3) / 2 * pitch ** 2
+                    / table_width,
+                    "bulk_speed_square_mm_s": 1e3 * q * pitch ** 2 / table_width,
+                    "bulk_speed_bound_mm_s": 1e3 * belt_velocity * opening_width / table_width})
+        k += 1
+    return out
+
+
+def fig7(opts: StudyOptions, stiff_duration: Optional[float] = None,
+         durations: Optional[Mapping[float, float]] = None,
+         window: float = 10.0) -> dict[str, Any]:
+    """Fig. 7: speed of the rectangular centre against time for each E (same runs as Fig. 6;
+    durations as there), panel (a) E <= 1e9 Pa, (b) E > 1e9 Pa. Writes
+    ``fig7_rectangular_centre_speed.png`` and ``fig7_findings.json``: per E the mean and peak
+    speed over the run, over its last 2 s and per ``window`` s (:func:`speed_windows`), the
+    time the sphere left the table (None if it did not), the belt's free-rolling speed
+    2/7 V_belt, and per window the discharge and the bulk speed it implies
+    (:func:`discharge_speeds`), all speeds in mm/s."""
+    runs = _run_all_moduli(opts, stiff_duration, durations)
     fig, axes = plt.subplots(2, 1, figsize=(8, 7), sharex=True)
     findings: dict[str, Any] = {}
     for e, run in runs:
         s = tagged_speed(run.velocities, run.tags, Tag.RECTANGULAR_CENTRE)
         ax = axes[0] if e <= 1e9 else axes[1]
-        ax.plot(run.times, 1e3 * s, lw=0.9, label=_e_label(e))
+        # the samples, faint, and their 2 s running mean
+        (line,) = ax.plot(run.times, 1e3 * s, lw=0.5, alpha=0.35)
+        smooth = moving_average(s, max(1, int(round(2.0 / float(np.median(np.diff(run.times)))))))
+        smooth[~np.isfinite(s)] = np.nan
+        ax.plot(run.times, 1e3 * smooth, lw=1.3, color=line.get_color(),
+                label=f"{_e_label(e)} (2 s mean)")
         late = run.times >= run.times[-1] - 2.0
+        gone = np.flatnonzero(np.isnan(s))
         findings[f"{e:.3g}"] = {
             "duration_s": float(run.times[-1]),
             "mean_speed_mm_s": float(1e3 * np.nanmean(s)),
             "peak_speed_mm_s": float(1e3 * np.nanmax(s)),
-            "mean_speed_last_2s_mm_s": float(1e3 * np.nanmean(s[late])),
+            "mean_speed_last_2s_mm_s": (float(1e3 * np.nanmean(s[late]))
+                                        if np.isfinite(s[late]).any() else None),
             "removed": bool(np.isnan(s[-1])),
+            "left_at_s": float(run.times[gone[0]]) if gone.size else None,
+            "windows": speed_windows(run.times, s, window),
+            "continuity": discharge_speeds(
+                run.removal_times, float(run.times[-1]), window,
+                float(run.parameters["width"]),
+                2.0 * float(run.parameters["sphere_radius"])
+                * (1.0 + float(run.parameters["packing_gap"])),
+                float(run.parameters["opening_width"]),
+                float(run.parameters["belt_velocity"])),
+            "n_removed": int(np.isfinite(run.removal_times).sum()),
+            "free_rolling_mm_s": 1e3 * 2.0 / 7.0 * FIG6_SETUP["belt_velocity"],
         }
     for ax, title in zip(axes, ("(a) E <= 1e9 Pa", "(b) E > 1e9 Pa")):
         ax.set_title(title, fontsize="medium")
         ax.set_ylabel("speed (mm/s)")
         if ax.lines:
+            ax.axhline(1e3 * 2.0 / 7.0 * FIG6_SETUP["belt_velocity"], color="grey", ls=":",
+                       lw=0.8, label="2/7 V_belt (free rolling)")
             ax.legend(fontsize="small")
     axes[-1].set_xlabel("time (s)")
     fig.suptitle("Fig. 7 analogue: rectangular-centre speed, V_belt = 0.1 m/s, T = 2 s, "
@@ -350,7 +484,8 @@ def fig7(opts: StudyOptions, stiff_duration: Optional[float] = None) -> dict[str
     write_text_atomic(opts.out / "fig7_findings.json", json.dumps(findings, indent=1) + "\n")
     opts.log("Fig. 7 findings (rectangular centre speed):\n" + "\n".join(
         f"  E={e:>8} Pa, {v['duration_s']:g} s: mean {v['mean_speed_mm_s']:.1f} mm/s, peak "
-        f"{v['peak_speed_mm_s']:.1f} mm/s, last 2 s {v['mean_speed_last_2s_mm_s']:.1f} mm/s"
+        f"{v['peak_speed_mm_s']:.1f} mm/s, left at {v['left_at_s']} s; per {window:g} s: "
+        + ", ".join(f"{w['mean_mm_s']:.0f}/{w['peak_mm_s']:.0f}" for w in v["windows"])
         for e, v in findings.items()))
     return findings
 

@@ -70,18 +70,27 @@ pub(crate) struct PairContact {
 
 /// Constants of one contact (a pair or a particle–wall slot) derived from the pair law, the
 /// reduced radius and the reduced mass once per neighbour-list rebuild, so the kernels do no
-/// division and no law-table lookup per step. For the Hertz laws (`hertz`), with s = √δ:
-/// F_el = `f_el` s δ, k_t = `k_t` s, c_n = `c_n` √s, which equal 4/3 E* a δ, 8 G* a and
-/// ζ √(2/3 m* 2E* a) for a = √(R* δ).
+/// division and no law-table lookup per step. What `f_el`, `k_t` and `c_n` hold depends on
+/// `kind`:
+/// - [`LawKind::Hertz`] (Hertz–Mindlin, or Hertz–Reissner without shell), with s = √δ:
+///   F_el = `f_el` s δ, k_t = `k_t` s, c_n = `c_n` √s, which equal 4/3 E* a δ, 8 G* a and
+///   ζ √(2/3 m* 2E* a) for a = √(R* δ);
+/// - [`LawKind::HertzReissner`], with u the root of u³ + u² = `s_scale` δ
+///   ([`contact::hertz_reissner_root`]): F_el = `f_el` u³, k_t = `k_t` u,
+///   c_n = `c_n` √(3u/(2 + 3u)), which equal F, 8 G* √(R* δ_H) with δ_H = (F/k_H)^{2/3}, and
+///   ζ √(2/3 m* dF/dδ) (see [`contact::HertzReissnerScaled`]);
+/// - [`LawKind::Linear`]: F_el = `f_el` δ, k_t = `k_t`, c_n = `c_n`.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct ContactConst {
     r_star: f64,
-    m_star: f64,
-    /// 4/3 E* √R*.
+    /// (k_H/k_R)², 1/m, for [`LawKind::HertzReissner`] (else 0): s = `s_scale` δ.
+    s_scale: f64,
+    /// Hertz: 4/3 E* √R*; Hertz–Reissner: k_R³/k_H², N; linear: k_n, N/m.
     f_el: f64,
-    /// 8 G* √R*.
+    /// Hertz: 8 G* √R*; Hertz–Reissner: 8 G* √R* k_R/k_H, N/m; linear: k_t, N/m.
     k_t: f64,
-    /// ζ √(4/3 m* E* √R*).
+    /// Hertz: ζ √(4/3 m* E* √R*); Hertz–Reissner: ζ √(2/3 m* k_R); linear: 2β √(m* k_n)
+    /// (the pair law's `linear_damping` = 2β); N·s/m times the powers of s or u above.
     c_n: f64,
     /// c_t / c_n.
     ct_ratio: f64,
@@ -89,29 +98,64 @@ pub(crate) struct ContactConst {
     mu: f64,
     /// Index of the pair law.
     law: u32,
-    /// The closed forms above apply (Hertz–Mindlin, or Hertz–Reissner without shell).
-    hertz: bool,
+    /// Which closed form applies.
+    kind: LawKind,
+}
+
+/// The normal law of a contact, as far as its per-step evaluation goes.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub(crate) enum LawKind {
+    /// Hertz–Mindlin, or Hertz–Reissner–Mindlin without shell compliance.
+    #[default]
+    Hertz,
+    /// Hertz in series with a Reissner shell, Mindlin on the Hertz indentation.
+    HertzReissner,
+    /// Linear spring–dashpot.
+    Linear,
 }
 
 impl ContactConst {
     fn new(model: ContactModel, laws: &[PairLaw], law: usize, r_star: f64, m_star: f64) -> Self {
         let l = &laws[law];
-        let hertz = match model {
-            ContactModel::HertzMindlin => true,
-            ContactModel::HertzReissnerMindlin => l.shell_stiffness.is_infinite(),
-            ContactModel::LinearSpringDashpot { .. } => false,
-        };
         let sr = r_star.sqrt();
-        ContactConst {
+        let base = ContactConst {
             r_star,
-            m_star,
+            s_scale: 0.0,
             f_el: 4.0 / 3.0 * l.e_star * sr,
             k_t: 8.0 * l.g_star * sr,
             c_n: l.zeta * (2.0 / 3.0 * m_star * (2.0 * l.e_star * sr)).sqrt(),
             ct_ratio: l.tangential_damping_ratio,
             mu: l.friction,
             law: law as u32,
-            hertz,
+            kind: LawKind::Hertz,
+        };
+        match model {
+            ContactModel::HertzMindlin => base,
+            ContactModel::HertzReissnerMindlin if l.shell_stiffness.is_infinite() => base,
+            ContactModel::HertzReissnerMindlin => {
+                // the law's constants were validated (E*, R* > 0, k_R finite > 0)
+                let k_h = base.f_el;
+                let k_r = l.shell_stiffness;
+                let hr = contact::HertzReissnerScaled::new_unchecked(k_h, k_r);
+                ContactConst {
+                    s_scale: hr.s_per_overlap,
+                    f_el: hr.force_scale,
+                    k_t: 8.0 * l.g_star * sr * (k_r / k_h),
+                    c_n: l.zeta * (2.0 / 3.0 * m_star * k_r).sqrt(),
+                    kind: LawKind::HertzReissner,
+                    ..base
+                }
+            }
+            ContactModel::LinearSpringDashpot {
+                normal_stiffness,
+                tangential_stiffness,
+            } => ContactConst {
+                f_el: normal_stiffness,
+                k_t: tangential_stiffness,
+                c_n: l.linear_damping * (m_star * normal_stiffness).sqrt(),
+                kind: LawKind::Linear,
+                ..base
+            },
         }
     }
 }
@@ -317,66 +361,6 @@ struct ParticleCtx<'a> {
     wall_stride: usize,
 }
 
-/// Normal and tangential law of one contact: elastic force, tangent stiffness, damping
-/// coefficient and tangential stiffness.
-#[inline(always)]
-fn contact_law(
-    model: ContactModel,
-    law: &PairLaw,
-    effects: EffectSet,
-    overlap: f64,
-    r_star: f64,
-    m_star: f64,
-) -> (f64, f64, f64, f64) {
-    let (f_el, k_n, k_t) = match model {
-        ContactModel::HertzMindlin => {
-            let a = (r_star * overlap).sqrt(); // contact radius
-            (
-                4.0 / 3.0 * law.e_star * a * overlap,
-                2.0 * law.e_star * a,
-                8.0 * law.g_star * a,
-            )
-        }
-        ContactModel::HertzReissnerMindlin => {
-            let k_h = 4.0 / 3.0 * law.e_star * r_star.sqrt();
-            if law.shell_stiffness.is_infinite() {
-                let a = (r_star * overlap).sqrt();
-                (
-                    4.0 / 3.0 * law.e_star * a * overlap,
-                    2.0 * law.e_star * a,
-                    8.0 * law.g_star * a,
-                )
-            } else {
-                let (f, k) = contact::NormalLaw::HertzReissner {
-                    k_h,
-                    k_r: law.shell_stiffness,
-                }
-                .force_and_stiffness(overlap);
-                // Mindlin spring on the Hertz indentation δ_H = (F/k_H)^{2/3} only
-                let delta_h = (f / k_h).powf(2.0 / 3.0);
-                (f, k, 8.0 * law.g_star * (r_star * delta_h).sqrt())
-            }
-        }
-        ContactModel::LinearSpringDashpot {
-            normal_stiffness,
-            tangential_stiffness,
-        } => (
-            normal_stiffness * overlap,
-            normal_stiffness,
-            tangential_stiffness,
-        ),
-    };
-    let c_n = if effects.has(Effect::Damping) {
-        match model {
-            ContactModel::LinearSpringDashpot { .. } => law.linear_damping * (m_star * k_n).sqrt(),
-            _ => law.zeta * (2.0 / 3.0 * m_star * k_n).sqrt(),
-        }
-    } else {
-        0.0
-    };
-    (f_el, c_n, k_t, k_n)
-}
-
 /// Tangential force with Mindlin history, rotated onto the current tangent plane, and the
 /// Coulomb cap. Returns the force on the first body and updates `history`.
 #[inline(always)]
@@ -448,33 +432,37 @@ fn on<const E: u16>(runtime: EffectSet, e: Effect) -> bool {
 }
 
 /// Elastic normal force, damping coefficient and tangential stiffness of a contact at
-/// overlap δ from its precomputed constants.
+/// overlap δ from its precomputed constants (see [`ContactConst`] for the closed forms).
 #[inline(always)]
 fn law_at<const E: u16>(
     k: &ContactConst,
-    model: ContactModel,
-    laws: &[PairLaw],
+    _model: ContactModel,
+    _laws: &[PairLaw],
     effects: EffectSet,
     overlap: f64,
 ) -> (f64, f64, f64) {
-    if k.hertz {
-        let s = overlap.sqrt();
-        let c_n = if on::<E>(effects, Effect::Damping) {
-            k.c_n * s.sqrt()
-        } else {
-            0.0
-        };
-        (k.f_el * s * overlap, c_n, k.k_t * s)
-    } else {
-        let (f_el, c_n, k_t, _) = contact_law(
-            model,
-            &laws[k.law as usize],
-            effects,
-            overlap,
-            k.r_star,
-            k.m_star,
-        );
-        (f_el, c_n, k_t)
+    let damping = on::<E>(effects, Effect::Damping);
+    match k.kind {
+        LawKind::Hertz => {
+            let s = overlap.sqrt();
+            let c_n = if damping { k.c_n * s.sqrt() } else { 0.0 };
+            (k.f_el * s * overlap, c_n, k.k_t * s)
+        }
+        LawKind::HertzReissner => {
+            let u = contact::hertz_reissner_root(k.s_scale * overlap);
+            // dF/dδ = k_R 3u/(2 + 3u), so c_n = ζ √(2/3 m* dF/dδ) = c_n √(3u/(2 + 3u))
+            let c_n = if damping {
+                let w = 3.0 * u;
+                k.c_n * (w / (2.0 + w)).sqrt()
+            } else {
+                0.0
+            };
+            (k.f_el * (u * u * u), c_n, k.k_t * u)
+        }
+        LawKind::Linear => {
+            let c_n = if damping { k.c_n } else { 0.0 };
+            (k.f_el * overlap, c_n, k.k_t)
+        }
     }
 }
 
