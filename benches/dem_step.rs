@@ -70,9 +70,7 @@ fn bench_threads(c: &mut Criterion, bytes: &[u8]) {
         if avx2 && !simd {
             eprintln!("no AVX2 on this CPU: {name} runs the baseline build");
         }
-        g.bench_function(name, |b| {
-            b.iter(|| sim.step(STEPS_PER_ITER).expect("step"))
-        });
+        g.bench_function(name, |b| b.iter(|| sim.step(STEPS_PER_ITER).expect("step")));
     }
     g.finish();
 }

@@ -232,9 +232,15 @@ fn hertz_reissner_root_is_exact_over_forty_decades() {
         let r = root_by_bisection(s);
         let err = (u - r).abs() / r;
         worst = worst.max(err);
-        assert!(err <= 1e-13, "s = {s:e}: u = {u:e}, bisection {r:e}, error {err:e}");
+        assert!(
+            err <= 1e-13,
+            "s = {s:e}: u = {u:e}, bisection {r:e}, error {err:e}"
+        );
     }
-    assert!(worst <= 8.0 * f64::EPSILON, "worst relative error {worst:e}");
+    assert!(
+        worst <= 8.0 * f64::EPSILON,
+        "worst relative error {worst:e}"
+    );
     // and densely: 100 000 log-uniform s in 1e-20 … 1e40 (the start's error varies within
     // each factor 8 of s through the cube-root seed)
     let mut state = 0x9E37_79B9_7F4A_7C15_u64;
@@ -244,17 +250,26 @@ fn hertz_reissner_root_is_exact_over_forty_decades() {
         state ^= state << 17;
         let s = 10f64.powf(-20.0 + 60.0 * (state >> 11) as f64 / (1u64 << 53) as f64);
         let (u, r) = (hertz_reissner_root(s), root_by_bisection(s));
-        assert!((u - r).abs() <= 8.0 * f64::EPSILON * r, "s = {s:e}: {u:e} vs {r:e}");
+        assert!(
+            (u - r).abs() <= 8.0 * f64::EPSILON * r,
+            "s = {s:e}: {u:e} vs {r:e}"
+        );
     }
     for &s in &[1e-300_f64, 1e-200, 1e-100, 1e-40, 1e-30] {
         let q = s.sqrt();
         let series = q - 0.5 * s + 0.625 * s * q;
-        assert!((hertz_reissner_root(s) / series - 1.0).abs() <= 4.0 * f64::EPSILON, "s = {s:e}");
+        assert!(
+            (hertz_reissner_root(s) / series - 1.0).abs() <= 4.0 * f64::EPSILON,
+            "s = {s:e}"
+        );
     }
     for &s in &[1e30_f64, 1e44, 1e45, 1e100, 1e200, 1e300, f64::MAX] {
         let t = s.cbrt();
         let series = t - 1.0 / 3.0 + 1.0 / (9.0 * t);
-        assert!((hertz_reissner_root(s) / series - 1.0).abs() <= 4.0 * f64::EPSILON, "s = {s:e}");
+        assert!(
+            (hertz_reissner_root(s) / series - 1.0).abs() <= 4.0 * f64::EPSILON,
+            "s = {s:e}"
+        );
     }
     assert_eq!(hertz_reissner_root(0.0), 0.0);
     assert_eq!(hertz_reissner_root(-1.0), 0.0);
@@ -278,9 +293,15 @@ fn scaled_hertz_reissner_law_satisfies_eq12() {
             let (f, k, d_h) = law.evaluate(d);
             let back = (f / k_h).powf(2.0 / 3.0) + f / k_r;
             assert!((back / d - 1.0).abs() < 1e-13, "E={e} δ={d}: {back}");
-            assert!((d_h / (f / k_h).powf(2.0 / 3.0) - 1.0).abs() < 1e-13, "E={e} δ={d}");
+            assert!(
+                (d_h / (f / k_h).powf(2.0 / 3.0) - 1.0).abs() < 1e-13,
+                "E={e} δ={d}"
+            );
             let k_exact = 1.0 / (2.0 / 3.0 / (f * k_h * k_h).cbrt() + 1.0 / k_r);
-            assert!((k / k_exact - 1.0).abs() < 1e-13, "E={e} δ={d}: {k} vs {k_exact}");
+            assert!(
+                (k / k_exact - 1.0).abs() < 1e-13,
+                "E={e} δ={d}: {k} vs {k_exact}"
+            );
             assert_eq!(f, hertz_reissner_force(d, k_h, k_r));
         }
         assert_eq!(law.evaluate(0.0), (0.0, 0.0, 0.0));

@@ -48,7 +48,11 @@ fn hertz_reissner_one_and_two_threads_are_bitwise_identical_and_restart_exactly(
     let mut b = packed_soft_hertz_reissner(2);
     a.step(1500).unwrap();
     b.step(1500).unwrap();
-    assert!(a.contacts().len() > 500, "too few contacts: {}", a.contacts().len());
+    assert!(
+        a.contacts().len() > 500,
+        "too few contacts: {}",
+        a.contacts().len()
+    );
     assert_eq!(bits(&a), bits(&b));
     let dir = std::env::temp_dir().join(format!("demfem-ck-hr-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();

@@ -149,9 +149,17 @@ fn hr_oscillation(
     let k_h = k_hertz(e_star(e, nu, 1e21, nu), r);
     let f0 = m * g;
     let delta0 = (f0 / k_h).powf(2.0 / 3.0) + f0 / k_r; // eq. 12 at rest
-    // the scene refuses friction or restitution < 1 without the effect that uses it
-    let mu = if effects.has(Effect::Friction) { 0.5 } else { 0.0 };
-    let rest = if effects.has(Effect::Damping) { 0.5 } else { 1.0 };
+                                                        // the scene refuses friction or restitution < 1 without the effect that uses it
+    let mu = if effects.has(Effect::Friction) {
+        0.5
+    } else {
+        0.0
+    };
+    let rest = if effects.has(Effect::Damping) {
+        0.5
+    } else {
+        1.0
+    };
     let mut mat = material(e, nu, rho, mu, rest);
     mat.shell_stiffness = k_r;
     let floor = rigid(nu, mu, rest);
@@ -213,7 +221,10 @@ fn hertz_reissner_mindlin_small_oscillations_match_linearised_law() {
     let (_, v, _) = hr_oscillation(k_r, kick, EffectSet::of(&[Effect::Gravity]), dt, 20_000);
     let vz: Vec<f64> = v.iter().map(|v| v.z).collect();
     let period = mean_period(&vz) * dt;
-    assert!((period / t_n - 1.0).abs() < 1e-4, "normal period {period} vs {t_n}");
+    assert!(
+        (period / t_n - 1.0).abs() < 1e-4,
+        "normal period {period} vs {t_n}"
+    );
 
     // tangential, undamped, no rotation
     let omega_t = 2.0 * std::f64::consts::PI / t_t;
@@ -223,10 +234,17 @@ fn hertz_reissner_mindlin_small_oscillations_match_linearised_law() {
     let (_, v, _) = hr_oscillation(k_r, kick, effects, dt, 20_000);
     let vx: Vec<f64> = v.iter().map(|v| v.x).collect();
     let period = mean_period(&vx) * dt;
-    assert!((period / t_t - 1.0).abs() < 1e-4, "tangential period {period} vs {t_t}");
+    assert!(
+        (period / t_t - 1.0).abs() < 1e-4,
+        "tangential period {period} vs {t_t}"
+    );
 
     // normal, damped: v(t + T_d) = v(t) exp(−γ T_d)
-    let zeta = demfem::contact::tsuji_damping_for_restitution(0.5, demfem::contact::ForceClamp::NonNegative).unwrap();
+    let zeta = demfem::contact::tsuji_damping_for_restitution(
+        0.5,
+        demfem::contact::ForceClamp::NonNegative,
+    )
+    .unwrap();
     let c_n = zeta * (2.0 / 3.0 * m * k_n).sqrt();
     let gamma = c_n / (2.0 * m);
     let t_d = 2.0 * std::f64::consts::PI / (omega_n * omega_n - gamma * gamma).sqrt();
@@ -235,5 +253,8 @@ fn hertz_reissner_mindlin_small_oscillations_match_linearised_law() {
     let effects = EffectSet::of(&[Effect::Gravity, Effect::Damping]);
     let (_, v, _) = hr_oscillation(k_r, kick, effects, dt, 10_000);
     let measured = (v[8_800].z / v[800].z).ln() / -t_d;
-    assert!((measured / gamma - 1.0).abs() < 1.5e-3, "decay rate {measured} vs {gamma}");
+    assert!(
+        (measured / gamma - 1.0).abs() < 1.5e-3,
+        "decay rate {measured} vs {gamma}"
+    );
 }

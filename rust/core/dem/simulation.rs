@@ -587,60 +587,45 @@ fn pair_chunk<const E: u16>(
 mod simd {
     use super::*;
 
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn pair_chunk_avx2<const E: u16>(
+    /// `$name(avx2, args…)` calls `$inner::<E>(args…)`, through `$avx` (the same body
+    /// compiled with AVX2 enabled) when `avx2` is set.
+    macro_rules! avx2_dispatch {
+        ($name:ident, $avx:ident, $inner:ident, ($($arg:ident: $ty:ty),*) -> $ret:ty) => {
+            #[cfg(target_arch = "x86_64")]
+            #[target_feature(enable = "avx2")]
+            #[allow(clippy::too_many_arguments)]
+            fn $avx<const E: u16>($($arg: $ty),*) -> $ret {
+                $inner::<E>($($arg),*)
+            }
+
+            #[inline(always)]
+            #[allow(clippy::too_many_arguments)]
+            pub(super) fn $name<const E: u16>(avx2: bool, $($arg: $ty),*) -> $ret {
+                #[cfg(target_arch = "x86_64")]
+                if avx2 {
+                    // SAFETY: `avx2` is true only when the CPU reported AVX2.
+                    return unsafe { $avx::<E>($($arg),*) };
+                }
+                let _ = avx2;
+                $inner::<E>($($arg),*)
+            }
+        };
+    }
+
+    avx2_dispatch!(pair, pair_chunk_avx2, pair_chunk, (
         chunk: &mut [PairContact],
         out: &mut [PairOut],
         konst: &[ContactConst],
-        c: &PairCtx<'_>,
-    ) -> u32 {
-        pair_chunk::<E>(chunk, out, konst, c)
-    }
+        c: &PairCtx<'_>
+    ) -> u32);
 
-    #[inline(always)]
-    pub(super) fn pair<const E: u16>(
-        avx2: bool,
-        chunk: &mut [PairContact],
-        out: &mut [PairOut],
-        konst: &[ContactConst],
-        c: &PairCtx<'_>,
-    ) -> u32 {
-        #[cfg(target_arch = "x86_64")]
-        if avx2 {
-            // SAFETY: `avx2` is true only when the CPU reported AVX2.
-            return unsafe { pair_chunk_avx2::<E>(chunk, out, konst, c) };
-        }
-        let _ = avx2;
-        pair_chunk::<E>(chunk, out, konst, c)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn wall_chunk_avx2<const E: u16>(c: &WallCtx<'_>, first: usize, slots: &mut [WallContact]) {
-        wall_chunk::<E>(c, first, slots)
-    }
-
-    #[inline(always)]
-    pub(super) fn wall<const E: u16>(
-        avx2: bool,
+    avx2_dispatch!(wall, wall_chunk_avx2, wall_chunk, (
         c: &WallCtx<'_>,
         first: usize,
-        slots: &mut [WallContact],
-    ) {
-        #[cfg(target_arch = "x86_64")]
-        if avx2 {
-            // SAFETY: `avx2` is true only when the CPU reported AVX2.
-            return unsafe { wall_chunk_avx2::<E>(c, first, slots) };
-        }
-        let _ = avx2;
-        wall_chunk::<E>(c, first, slots)
-    }
+        slots: &mut [WallContact]
+    ) -> ());
 
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    #[allow(clippy::too_many_arguments)]
-    fn particle_chunk_avx2<const E: u16>(
+    avx2_dispatch!(particle, particle_chunk_avx2, particle_chunk, (
         c: &ParticleCtx<'_>,
         first: usize,
         position: &mut [Vec3],
@@ -649,65 +634,8 @@ mod simd {
         force_sum: &mut [Vec3],
         coordination: &mut [u32],
         wall_coordination: &mut [u32],
-        slots: &[WallContact],
-    ) -> (f64, bool, u32) {
-        particle_chunk::<E>(
-            c,
-            first,
-            position,
-            velocity,
-            omega,
-            force_sum,
-            coordination,
-            wall_coordination,
-            slots,
-        )
-    }
-
-    #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
-    pub(super) fn particle<const E: u16>(
-        avx2: bool,
-        c: &ParticleCtx<'_>,
-        first: usize,
-        position: &mut [Vec3],
-        velocity: &mut [Vec3],
-        omega: &mut [Vec3],
-        force_sum: &mut [Vec3],
-        coordination: &mut [u32],
-        wall_coordination: &mut [u32],
-        slots: &[WallContact],
-    ) -> (f64, bool, u32) {
-        #[cfg(target_arch = "x86_64")]
-        if avx2 {
-            // SAFETY: `avx2` is true only when the CPU reported AVX2.
-            return unsafe {
-                particle_chunk_avx2::<E>(
-                    c,
-                    first,
-                    position,
-                    velocity,
-                    omega,
-                    force_sum,
-                    coordination,
-                    wall_coordination,
-                    slots,
-                )
-            };
-        }
-        let _ = avx2;
-        particle_chunk::<E>(
-            c,
-            first,
-            position,
-            velocity,
-            omega,
-            force_sum,
-            coordination,
-            wall_coordination,
-            slots,
-        )
-    }
+        slots: &[WallContact]
+    ) -> (f64, bool, u32));
 }
 
 /// Closest point, unit normal (wall → x) and distance of a wall slot when the sphere of
@@ -1416,7 +1344,9 @@ impl Simulation {
                 (&mut [PairContact], &mut [PairOut]),
                 &[ContactConst],
             )|
-             -> u32 { simd::pair::<E>(avx2, chunk, out, konst, &pair_ctx) };
+             -> u32 {
+                simd::pair::<E>(avx2, chunk, out, konst, &pair_ctx)
+            };
             let (pairs, pair_out, pair_const) =
                 (&mut self.pairs, &mut self.pair_out, &self.pair_const);
             let (onsets, slots) = (&mut self.chunk_onsets, &mut self.wall_slots);
