@@ -25,19 +25,8 @@ fn tilted_collision(tilt_a: f64, tilt_b: f64, speed: f64, spin: f64) -> (f64, f6
         ..Default::default()
     };
     let (shape, mass) = cartridge("exact");
-    let mut scene = RigidScene::new(config.clone()).unwrap();
-    let id = scene.add_shape(shape.clone(), mass).unwrap();
-    scene
-        .add_body(
-            id,
-            Vector3::zeros(),
-            UnitQuaternion::identity(),
-            Vector3::zeros(),
-            Vector3::zeros(),
-        )
-        .unwrap();
     // a quarter of the 5 m/s limit: the Verlet error of one impact (∝ Δt²) stays < 1e-4
-    let dt = 0.25 * scene.time_step_limit().unwrap();
+    let dt = 0.25 * time_step_limit_of(config.clone(), "exact");
     let mut scene = RigidScene::new(RigidSceneConfig {
         time_step: Some(dt),
         ..config

@@ -274,18 +274,7 @@ fn skew_exact_cartridges_touch_only_where_their_sides_cross() {
 #[test]
 fn time_step_above_the_limit_is_refused() {
     let (shape, mass) = cartridge("clump");
-    let mut scene = RigidScene::new(RigidSceneConfig::default()).unwrap();
-    let id = scene.add_shape(shape.clone(), mass).unwrap();
-    scene
-        .add_body(
-            id,
-            Vector3::zeros(),
-            UnitQuaternion::identity(),
-            Vector3::zeros(),
-            Vector3::zeros(),
-        )
-        .unwrap();
-    let limit = scene.time_step_limit().unwrap();
+    let limit = time_step_limit_of(RigidSceneConfig::default(), "clump");
     assert!(limit > 1e-7 && limit < 1e-5, "{limit}");
     let config = RigidSceneConfig {
         time_step: Some(2.0 * limit),

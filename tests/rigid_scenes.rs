@@ -91,19 +91,7 @@ fn head_on_pair(kind: &str, other_kind: &str, restitution: f64) -> (f64, f64, f6
     };
     // the step at the limit is sized for 5 m/s impacts; this slow one (0.2 m/s) is
     // integrated with a quarter of it so the Verlet error of the impact (∝ Δt²) is below 1e-4
-    let limit = {
-        let (mut probe, id) = scene_with(config.clone(), kind);
-        probe
-            .add_body(
-                id,
-                Vector3::zeros(),
-                UnitQuaternion::identity(),
-                Vector3::zeros(),
-                Vector3::zeros(),
-            )
-            .unwrap();
-        probe.time_step_limit().unwrap()
-    };
+    let limit = time_step_limit_of(config.clone(), kind);
     let config = RigidSceneConfig {
         time_step: Some(0.25 * limit),
         ..config

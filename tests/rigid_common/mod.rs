@@ -3,7 +3,10 @@
 //! as an exact parry shape, both with their mass properties.
 #![allow(dead_code)]
 
-use demfem::rigid::{BeadClump, ExactShape, MassProperties, RevolutionProfile, RigidShape};
+use demfem::rigid::{
+    BeadClump, ExactShape, MassProperties, RevolutionProfile, RigidScene, RigidSceneConfig,
+    RigidShape,
+};
 use nalgebra::{UnitQuaternion, Vector3};
 
 /// Density of the paper's glass, kg/m³.
@@ -65,4 +68,22 @@ pub fn com_height() -> f64 {
 /// Angle between the body axis (body z) and world z, degrees.
 pub fn tilt_degrees(q: &UnitQuaternion<f64>) -> f64 {
     (q * Vector3::z()).z.clamp(-1.0, 1.0).acos().to_degrees()
+}
+
+/// Stable time-step limit (s) of a scene with `config` holding one cartridge of `kind`
+/// ("clump" or "exact") at rest at the origin: the probe the tests size their steps with.
+pub fn time_step_limit_of(config: RigidSceneConfig, kind: &str) -> f64 {
+    let (shape, mass) = cartridge(kind);
+    let mut probe = RigidScene::new(config).unwrap();
+    let id = probe.add_shape(shape, mass).unwrap();
+    probe
+        .add_body(
+            id,
+            Vector3::zeros(),
+            UnitQuaternion::identity(),
+            Vector3::zeros(),
+            Vector3::zeros(),
+        )
+        .unwrap();
+    probe.time_step_limit().unwrap()
 }

@@ -488,22 +488,7 @@ fn manifold_contacts(
             let same_contact = out[first_new..]
                 .iter()
                 .position(|c| (c.point - point).norm() < reach && c.normal.dot(&normal) > 0.999);
-            if let Some(k) = same_contact {
-                let existing = &mut out[first_new + k];
-                if overlap > existing.overlap * (1.0 + 1e-9) {
-                    *existing = ContactPoint {
-                        point,
-                        normal,
-                        overlap,
-                        radius_first: r1,
-                        radius_second: r2,
-                        feature_first,
-                        feature_second,
-                    };
-                }
-                continue;
-            }
-            out.push(ContactPoint {
+            let found = ContactPoint {
                 point,
                 normal,
                 overlap,
@@ -511,7 +496,17 @@ fn manifold_contacts(
                 radius_second: r2,
                 feature_first,
                 feature_second,
-            });
+            };
+            match same_contact {
+                // the same touch reported twice: keep the deeper report
+                Some(k) => {
+                    let existing = &mut out[first_new + k];
+                    if overlap > existing.overlap * (1.0 + 1e-9) {
+                        *existing = found;
+                    }
+                }
+                None => out.push(found),
+            }
         }
     }
     Ok(())
