@@ -311,7 +311,8 @@ impl std::fmt::Debug for Simulation {
     }
 }
 
-/// Read-only context of the pair kernel.
+/// Read-only context of the pair kernel; the wall kernels share it (see [`WallCtx`]).
+#[derive(Clone, Copy)]
 struct PairCtx<'a> {
     position: &'a [Vec3],
     velocity: &'a [Vec3],
@@ -327,19 +328,11 @@ struct PairCtx<'a> {
 
 /// Read-only context of the wall kernels (run in the force phase, next to the pairs).
 struct WallCtx<'a> {
-    position: &'a [Vec3],
-    velocity: &'a [Vec3],
-    omega: &'a [Vec3],
+    /// State, laws and settings shared with the pair kernel.
+    shared: PairCtx<'a>,
     alive: &'a [bool],
-    radius: &'a [f64],
-    inertia: &'a [f64],
     walls: &'a [Wall],
     wall_state: &'a [WallState],
-    laws: &'a [PairLaw],
-    model: ContactModel,
-    effects: EffectSet,
-    clamp: bool,
-    dt: f64,
     wall_stride: usize,
 }
 
@@ -675,13 +668,13 @@ fn wall_kernel<const E: u16>(
 ) {
     let wall = &c.walls[s.wall as usize];
     // fixed walls (no moving_walls effect) sit at offset 0 with velocity 0: skip both
-    let moving = on::<E>(c.effects, Effect::MovingWalls);
+    let moving = on::<E>(c.shared.effects, Effect::MovingWalls);
     let ws = if moving {
         c.wall_state[s.wall as usize]
     } else {
         WallState::default()
     };
-    let r = c.radius[i];
+    let r = c.shared.radius[i];
     let (point, out_normal, dist) = match wall_hit(wall, x, moving.then_some(ws.offset), r) {
         Some(h) => h,
         None => {
@@ -699,10 +692,10 @@ fn wall_kernel<const E: u16>(
     };
     let n = -out_normal; // from the particle towards the wall
     let overlap = r - dist;
-    let rotation = on::<E>(c.effects, Effect::Rotation);
+    let rotation = on::<E>(c.shared.effects, Effect::Rotation);
     let arm = dist.max(0.0);
     let mut wall_v = ws.velocity;
-    if on::<E>(c.effects, Effect::Belt) {
+    if on::<E>(c.shared.effects, Effect::Belt) {
         let s_v = wall.surface_velocity;
         let belt = s_v - s_v.dot(n) * n;
         wall_v = if moving { wall_v + belt } else { belt };
@@ -720,15 +713,21 @@ fn wall_kernel<const E: u16>(
         s.onset_normal_speed = v_n;
         s.onset_tangential_speed = v_t.length();
     }
-    let (f_el, c_n, k_t) = law_at::<E>(&s.k, c.model, c.laws, c.effects, overlap);
+    let (f_el, c_n, k_t) = law_at::<E>(
+        &s.k,
+        c.shared.model,
+        c.shared.laws,
+        c.shared.effects,
+        overlap,
+    );
     let (ct_ratio, mu, law) = (s.k.ct_ratio, s.k.mu, s.k.law as usize);
     let mut f_n = f_el + c_n * v_n;
-    if c.clamp && f_n < 0.0 {
+    if c.shared.clamp && f_n < 0.0 {
         f_n = 0.0;
     }
     let mut force = -f_n * n;
     let mut torque = Vec3::ZERO;
-    if on::<E>(c.effects, Effect::Friction) {
+    if on::<E>(c.shared.effects, Effect::Friction) {
         let f_t = tangential_force(
             &mut s.history,
             n,
@@ -736,19 +735,20 @@ fn wall_kernel<const E: u16>(
             k_t,
             c_n * ct_ratio,
             mu * f_n.max(0.0),
-            c.dt,
+            c.shared.dt,
         );
         force += f_t;
         if rotation {
             torque = arm * n.cross(f_t);
         }
     }
-    if on::<E>(c.effects, Effect::RollingResistance) {
-        let law = &c.laws[law];
+    if on::<E>(c.shared.effects, Effect::RollingResistance) {
+        let law = &c.shared.laws[law];
         let w_roll = w - w.dot(n) * n;
         let w_mag = w_roll.length();
         if w_mag > 0.0 {
-            let m = (law.rolling_friction * r * f_n.max(0.0)).min(c.inertia[i] * w_mag / c.dt);
+            let m = (law.rolling_friction * r * f_n.max(0.0))
+                .min(c.shared.inertia[i] * w_mag / c.shared.dt);
             torque -= m / w_mag * w_roll;
         }
     }
@@ -768,7 +768,11 @@ fn wall_chunk<const E: u16>(c: &WallCtx<'_>, first: usize, slots: &mut [WallCont
         if !c.alive[i] {
             continue;
         }
-        let (x, v, w) = (c.position[i], c.velocity[i], c.omega[i]);
+        let (x, v, w) = (
+            c.shared.position[i],
+            c.shared.velocity[i],
+            c.shared.omega[i],
+        );
         for s in slots.iter_mut() {
             if s.wall == NO_WALL {
                 break;
@@ -1325,19 +1329,10 @@ impl Simulation {
                 dt: self.dt,
             };
             let wall_ctx = WallCtx {
-                position: &self.position,
-                velocity: &self.velocity,
-                omega: &self.omega,
+                shared: pair_ctx,
                 alive: &self.alive,
-                radius: &self.radius,
-                inertia: &self.inertia,
                 walls: &self.walls,
                 wall_state: &self.wall_state,
-                laws: &self.laws,
-                model: self.model,
-                effects: self.effects,
-                clamp: self.clamp,
-                dt: self.dt,
                 wall_stride: stride,
             };
             let kernel = |((chunk, out), konst): (
