@@ -35,12 +35,14 @@ def run_anchor(cmd: list[str], cwd: str) -> dict:
     raise RuntimeError(f"{cmd[0]} gave no RESULT line:\n{out.stdout[-2000:]}\n{out.stderr[-2000:]}")
 
 
-def prep_steps(e: float, anchors: str) -> int:
-    """Steps the anchors take to make their packed state (1.511 s simulated; bench_all.py)."""
-    sys.path.insert(0, anchors)
-    import bench_all  # noqa: E402  (the anchors' own definition, so all codes agree)
+def anchors_module(anchors: str):
+    """The anchors' ``bench_all.py``: their own definitions of the packed-state recipe and
+    files, so that all codes agree."""
+    if anchors not in sys.path:
+        sys.path.insert(0, anchors)
+    import bench_all  # noqa: E402
 
-    return int(bench_all.prep_steps(e))
+    return bench_all
 
 
 def demfem_packed_state(e: float, anchors: str, cache: str) -> str:
@@ -50,7 +52,7 @@ def demfem_packed_state(e: float, anchors: str, cache: str) -> str:
 
     path = os.path.join(cache, f"demfem_funnel_E{e:g}.ck")
     if not os.path.exists(path):
-        n = prep_steps(e, anchors)
+        n = int(anchors_module(anchors).prep_steps(e))
         print(f"preparing demfem's packed state: {n} steps (cached in {path})", flush=True)
         sim = DemSimulation.anchor_table(e, start="square", threads=2, initial_vx=0.2)
         sim.step(n)
@@ -98,9 +100,7 @@ def main() -> None:
     anchors = os.path.abspath(ANCHORS)
     packed = a.state == "packed"
     if packed:
-        sys.path.insert(0, anchors)
-        import bench_all  # noqa: E402
-
+        bench_all = anchors_module(anchors)
         lig_state, yade_state = bench_all.state_file("liggghts", a.E), bench_all.state_file("yade", a.E)
         for f in (lig_state, yade_state):
             if not os.path.exists(f):
