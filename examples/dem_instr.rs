@@ -75,6 +75,9 @@ fn main() {
             hash = (hash ^ x.to_bits()).wrapping_mul(0x100000001b3);
         }
     }
+    let (pairs, slots) = sim.candidate_counts();
+    let walls: u32 = sim.wall_contact_counts().iter().sum();
+    eprintln!("candidate pairs {pairs} wall slots {slots} active wall contacts {walls}");
     println!(
         "state hash {hash:016x} steps {} rebuilds {} Z {:.3} max overlap {:.3e} x0 {:?}",
         sim.steps(),

@@ -151,10 +151,10 @@ impl Simulation {
             w.vec3(*v);
         }
         w.u64(self.pairs.len() as u64);
-        for p in &self.pairs {
+        for (p, &active) in self.pairs.iter().zip(&self.pair_active) {
             w.u32(p.i);
             w.u32(p.j);
-            w.u8(p.active as u8);
+            w.u8(active as u8);
             w.vec3(p.history);
         }
         w.u64(self.wall_stride as u64);
@@ -243,6 +243,7 @@ impl Simulation {
         }
         let n_pairs = r.count(data.len() / 33 + 1, "pair")?;
         let mut pairs = Vec::with_capacity(n_pairs);
+        let mut pair_active = Vec::with_capacity(n_pairs);
         for _ in 0..n_pairs {
             let i = r.u32()?;
             let j = r.u32()?;
@@ -254,10 +255,10 @@ impl Simulation {
             pairs.push(PairContact {
                 i,
                 j,
-                active,
                 history,
                 ..Default::default()
             });
+            pair_active.push(active);
         }
         let stride = r.count(self.walls.len().max(1), "wall stride")?.max(1);
         let n_slots = r.count(n * stride, "wall slot")?;
@@ -293,6 +294,7 @@ impl Simulation {
         self.alive = alive;
         self.reference_wall_offset = wall_ref;
         self.pairs = pairs;
+        self.pair_active = pair_active;
         self.wall_stride = stride;
         self.wall_slots = slots;
         self.build_gather_lists();

@@ -17,6 +17,19 @@
 //! (`ContactConst`), so a contact costs three square roots (distance, √δ, δ^{1/4}) and one
 //! division, plus a square root and two divisions in gross sliding.
 //!
+//! Contacts are evaluated in batches (module `batch`): a chunk's contacts are found and
+//! gathered first, then their geometry, laws and forces are computed in short loops (four
+//! contacts per instruction with AVX2), then scattered. One contact at a time, its chain of
+//! dependent operations (δ → √δ → δ^{1/4} → f_n → Coulomb cap → scaling) kept the processor
+//! waiting; in a batch the chains of many contacts overlap. The one-at-a-time kernels
+//! (`pair_kernel`, `wall_kernel`) remain the reference, used with rolling resistance, and
+//! the batches reproduce them bit for bit ([`Simulation::set_batched`]).
+//!
+//! What a step writes is split by who reads it: the state the next step needs (`PairContact`,
+//! `WallContact`, 48 and 96 bytes), what the particle phase gathers (`PairOut`, `WallOut`),
+//! and what only the records read (`PairDetail`, `WallDetail`), written on the last step of
+//! each [`Simulation::step`] call, so the step streams a third fewer cache lines.
+//!
 //! Every floating-point sum is taken in an order fixed by the lists, never by the thread
 //! schedule, so results are bitwise identical for any thread count; the step synchronises
 //! twice. Systems below [`PARALLEL_MIN_PARTICLES`] run serially.
@@ -32,6 +45,9 @@ use crate::dem::scene::Scene;
 use crate::error::{DemfemError, Result};
 use crate::geometry::{Vec3, Wall, WallShape};
 
+mod batch;
+use batch::{pair_chunk_batched, wall_chunk_batched, Batch, BATCH, BATCH_SCRATCH};
+
 /// Below this many particles the step runs on the calling thread whatever `threads` says:
 /// a rayon fork-join costs microseconds, as much as the whole step of a small system.
 pub const PARALLEL_MIN_PARTICLES: usize = 256;
@@ -39,33 +55,38 @@ const PAIR_CHUNK: usize = 256;
 const PARTICLE_CHUNK: usize = 64;
 const NO_WALL: u32 = u32::MAX;
 
-/// A candidate particle pair of the Verlet list with its contact state. `repr(C)` with what
-/// the pair phase reads for every candidate (i, j, the activity flags and r_i + r_j) at the
-/// front, so a pair that is not in contact costs one cache line and no store.
+/// A candidate particle pair of the Verlet list with the contact state the step carries: 48
+/// bytes, what the pair phase reads for every candidate (i, j, r_i + r_j) first. Whether the
+/// pair is in contact is kept apart, in [`Simulation::pair_active`] (one byte per pair, so the
+/// gather's test of every candidate stays in L1). What the step produces goes to [`PairOut`] (read by the gather) and, on
+/// the last step of a [`Simulation::step`] call, to [`PairDetail`] (read only by the records),
+/// so a step streams as few cache lines as it can.
 #[derive(Debug, Clone, Copy, Default)]
 #[repr(C)]
 pub(crate) struct PairContact {
     pub(crate) i: u32,
     pub(crate) j: u32,
-    /// In contact at the last force evaluation.
-    pub(crate) active: bool,
     /// The contact began at the last force evaluation.
     pub(crate) onset: bool,
     /// r_i + r_j, m (derived from the radii at rebuild and restore; not checkpointed).
     pub(crate) r_sum: f64,
     /// Tangential spring displacement ξ, m (Mindlin history).
     pub(crate) history: Vec3,
-    /// Force on particle i, N.
-    pub(crate) force: Vec3,
+}
+
+/// What only the records read of an active pair: the normal and the normal force, written on
+/// the last step of each [`Simulation::step`] call (so they describe the last force
+/// evaluation whenever the caller can look), and the relative speeds at onset, written when
+/// the contact begins.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct PairDetail {
     /// Unit normal from i to j.
-    pub(crate) normal: Vec3,
-    /// Overlap δ, m; > 0 exactly when the pair is in contact.
-    pub(crate) overlap: f64,
-    pub(crate) normal_force: f64,
-    /// Rolling-resistance torque on i (−this on j), N·m.
-    pub(crate) rolling_torque: Vec3,
-    pub(crate) onset_normal_speed: f64,
-    pub(crate) onset_tangential_speed: f64,
+    normal: Vec3,
+    /// Normal force, N (> 0 compressive).
+    normal_force: f64,
+    /// Normal and tangential relative speed at onset, m/s.
+    onset_normal_speed: f64,
+    onset_tangential_speed: f64,
 }
 
 /// Constants of one contact (a pair or a particle–wall slot) derived from the pair law, the
@@ -172,44 +193,52 @@ pub(crate) struct PairOut {
     overlap: f64,
 }
 
-/// A candidate particle–wall contact slot.
+/// A candidate particle–wall contact slot: the state the step carries and the law constants
+/// (96 bytes). Its force and torque go to [`WallOut`], the record-only values to
+/// [`WallDetail`], as for pairs.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct WallContact {
     pub(crate) wall: u32,
-    /// Law constants of this particle against this wall (derived, not checkpointed).
-    pub(crate) k: ContactConst,
     pub(crate) active: bool,
     pub(crate) onset: bool,
     pub(crate) history: Vec3,
-    pub(crate) force: Vec3,
-    /// Torque on the particle, N·m (zero when not in contact).
-    pub(crate) torque: Vec3,
-    pub(crate) normal: Vec3,
-    pub(crate) point: Vec3,
-    pub(crate) overlap: f64,
-    pub(crate) normal_force: f64,
-    pub(crate) onset_normal_speed: f64,
-    pub(crate) onset_tangential_speed: f64,
+    /// Law constants of this particle against this wall (derived, not checkpointed).
+    pub(crate) k: ContactConst,
 }
 
 impl Default for WallContact {
     fn default() -> Self {
         WallContact {
             wall: NO_WALL,
-            k: ContactConst::default(),
             active: false,
             onset: false,
             history: Vec3::ZERO,
-            force: Vec3::ZERO,
-            torque: Vec3::ZERO,
-            normal: Vec3::ZERO,
-            point: Vec3::ZERO,
-            overlap: 0.0,
-            normal_force: 0.0,
-            onset_normal_speed: 0.0,
-            onset_tangential_speed: 0.0,
+            k: ContactConst::default(),
         }
     }
+}
+
+/// Force (N) and torque (N·m) of an active wall slot on its particle, read by the gather.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct WallOut {
+    force: Vec3,
+    torque: Vec3,
+}
+
+/// What only the records read of an active wall slot (see [`PairDetail`]); the contact point
+/// is also written at onset.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct WallDetail {
+    /// Unit normal from the particle towards the wall.
+    normal: Vec3,
+    /// Contact point on the wall, m.
+    point: Vec3,
+    /// Overlap, m.
+    overlap: f64,
+    /// Normal force, N.
+    normal_force: f64,
+    onset_normal_speed: f64,
+    onset_tangential_speed: f64,
 }
 
 /// Current position offset and velocity of each wall.
@@ -251,6 +280,8 @@ pub struct Simulation {
     pub(crate) threads: usize,
     /// Step with the AVX2 build of the kernels (bitwise the same results; see `simd`).
     avx2: bool,
+    /// Evaluate contacts in batches ([`Batch`]; bitwise the same results as one at a time).
+    batched: bool,
     pub(crate) record_every: u64,
     pub(crate) record_onsets: bool,
     /// Outlet plane (point, unit normal towards the kept side).
@@ -263,10 +294,20 @@ pub struct Simulation {
     pub(crate) time: f64,
     pub(crate) steps: u64,
     pub(crate) pairs: Vec<PairContact>,
+    /// Whether each pair was in contact at the last force evaluation.
+    pub(crate) pair_active: Vec<bool>,
     pair_out: Vec<PairOut>,
+    /// Record-only values of each pair (see [`PairDetail`]).
+    pair_detail: Vec<PairDetail>,
+    /// Rolling-resistance torque on i (−this on j) of each pair, N·m (`rolling_resistance`).
+    pair_rolling: Vec<Vec3>,
     /// Law constants of each pair (derived at rebuild and restore).
     pair_const: Vec<ContactConst>,
     pub(crate) wall_slots: Vec<WallContact>,
+    wall_out: Vec<WallOut>,
+    wall_detail: Vec<WallDetail>,
+    /// This step writes the record-only values (the last step of a [`Simulation::step`] call).
+    detail: bool,
     pub(crate) wall_stride: usize,
     pub(crate) reference_position: Vec<Vec3>,
     pub(crate) reference_wall_offset: Vec<Vec3>,
@@ -282,6 +323,7 @@ pub struct Simulation {
     grid: CellGrid,
     candidate_scratch: Vec<(u32, u32)>,
     old_pairs: Vec<PairContact>,
+    old_pair_active: Vec<bool>,
     old_slots: Vec<WallContact>,
     wall_state: Vec<WallState>,
     chunk_onsets: Vec<u32>,
@@ -324,6 +366,13 @@ struct PairCtx<'a> {
     effects: EffectSet,
     clamp: bool,
     dt: f64,
+    /// Write the record-only values.
+    detail: bool,
+    /// The CPU has AVX2 and the step uses it (the batched force pass runs four contacts per
+    /// instruction).
+    avx2: bool,
+    /// Evaluate contacts in batches.
+    batched: bool,
 }
 
 /// Read-only context of the wall kernels (run in the force phase, next to the pairs).
@@ -338,7 +387,8 @@ struct WallCtx<'a> {
 
 /// Read-only context of the particle phase.
 struct ParticleCtx<'a> {
-    pairs: &'a [PairContact],
+    pair_active: &'a [bool],
+    pair_rolling: &'a [Vec3],
     pair_out: &'a [PairOut],
     csr_offset: &'a [u32],
     csr_entry: &'a [u32],
@@ -461,10 +511,14 @@ fn law_at<const E: u16>(
 
 /// Force of one candidate pair; returns whether a contact began.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 fn pair_kernel<const E: u16>(
     p: &mut PairContact,
+    active: &mut bool,
     k: &ContactConst,
     out: &mut PairOut,
+    detail: &mut PairDetail,
+    rolling_torque: &mut Vec3,
     c: &PairCtx<'_>,
 ) -> bool {
     let i = p.i as usize;
@@ -475,14 +529,10 @@ fn pair_kernel<const E: u16>(
     if dist2 >= r_sum * r_sum || dist2 == 0.0 {
         // an inactive pair has nothing to reset: its output slot already reads "no contact"
         // (onset is only ever set together with active)
-        if p.active {
-            p.active = false;
+        if *active {
+            *active = false;
             p.onset = false;
             p.history = Vec3::ZERO;
-            p.force = Vec3::ZERO;
-            p.rolling_torque = Vec3::ZERO;
-            p.overlap = 0.0;
-            p.normal_force = 0.0;
             out.overlap = 0.0;
         }
         return false;
@@ -500,13 +550,13 @@ fn pair_kernel<const E: u16>(
         v_rel += (arm_i * c.omega[i] + arm_j * c.omega[j]).cross(n);
     }
     let v_n = v_rel.dot(n); // > 0 approaching
-    let onset = !p.active;
-    p.active = true;
+    let onset = !*active;
+    *active = true;
     p.onset = onset;
     let v_t = v_rel - v_n * n;
     if onset {
-        p.onset_normal_speed = v_n;
-        p.onset_tangential_speed = v_t.length();
+        detail.onset_normal_speed = v_n;
+        detail.onset_tangential_speed = v_t.length();
     }
     let (f_el, c_n, k_t) = law_at::<E>(k, c.model, c.laws, c.effects, overlap);
     let mut f_n = f_el + c_n * v_n;
@@ -539,15 +589,15 @@ fn pair_kernel<const E: u16>(
             let i_star = c.inertia[i] * c.inertia[j] / (c.inertia[i] + c.inertia[j]);
             // constant torque, but never more than what stops the relative rolling in one step
             let m = (law.rolling_friction * k.r_star * f_n.max(0.0)).min(i_star * w_mag / c.dt);
-            p.rolling_torque = -m / w_mag * w_roll;
+            *rolling_torque = -m / w_mag * w_roll;
         } else {
-            p.rolling_torque = Vec3::ZERO;
+            *rolling_torque = Vec3::ZERO;
         }
     }
-    p.force = force;
-    p.normal = n;
-    p.overlap = overlap;
-    p.normal_force = f_n;
+    if c.detail {
+        detail.normal = n;
+        detail.normal_force = f_n;
+    }
     *out = PairOut {
         force,
         torque_per_arm,
@@ -558,15 +608,30 @@ fn pair_kernel<const E: u16>(
 
 /// Pair kernels of one chunk of the pair list; returns the number of onsets.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 fn pair_chunk<const E: u16>(
     chunk: &mut [PairContact],
+    active: &mut [bool],
     out: &mut [PairOut],
+    detail: &mut [PairDetail],
+    rolling: &mut [Vec3],
     konst: &[ContactConst],
     c: &PairCtx<'_>,
+    batch: &mut Batch,
 ) -> u32 {
+    if c.batched && !on::<E>(c.effects, Effect::RollingResistance) {
+        return pair_chunk_batched::<E>(chunk, active, out, detail, konst, c, batch);
+    }
     let mut onsets = 0u32;
-    for ((p, o), k) in chunk.iter_mut().zip(out.iter_mut()).zip(konst) {
-        onsets += pair_kernel::<E>(p, k, o, c) as u32;
+    for (((((p, a), o), d), r), k) in chunk
+        .iter_mut()
+        .zip(active.iter_mut())
+        .zip(out.iter_mut())
+        .zip(detail.iter_mut())
+        .zip(rolling.iter_mut())
+        .zip(konst)
+    {
+        onsets += pair_kernel::<E>(p, a, k, o, d, r, c) as u32;
     }
     onsets
 }
@@ -607,15 +672,22 @@ mod simd {
 
     avx2_dispatch!(pair, pair_chunk_avx2, pair_chunk, (
         chunk: &mut [PairContact],
+        active: &mut [bool],
         out: &mut [PairOut],
+        detail: &mut [PairDetail],
+        rolling: &mut [Vec3],
         konst: &[ContactConst],
-        c: &PairCtx<'_>
+        c: &PairCtx<'_>,
+        batch: &mut Batch
     ) -> u32);
 
     avx2_dispatch!(wall, wall_chunk_avx2, wall_chunk, (
         c: &WallCtx<'_>,
         first: usize,
-        slots: &mut [WallContact]
+        slots: &mut [WallContact],
+        out: &mut [WallOut],
+        detail: &mut [WallDetail],
+        batch: &mut Batch
     ) -> ());
 
     avx2_dispatch!(particle, particle_chunk_avx2, particle_chunk, (
@@ -627,7 +699,8 @@ mod simd {
         force_sum: &mut [Vec3],
         coordination: &mut [u32],
         wall_coordination: &mut [u32],
-        slots: &[WallContact]
+        slots: &[WallContact],
+        wall_out: &[WallOut]
     ) -> (f64, bool, u32));
 }
 
@@ -658,8 +731,11 @@ fn wall_hit(wall: &Wall, x: Vec3, offset: Option<Vec3>, r: f64) -> Option<(Vec3,
 /// Force and torque of one particle–wall slot on particle i, stored in the slot with the
 /// contact state; flags onset.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 fn wall_kernel<const E: u16>(
     s: &mut WallContact,
+    o: &mut WallOut,
+    detail: &mut WallDetail,
     i: usize,
     x: Vec3,
     v: Vec3,
@@ -681,10 +757,6 @@ fn wall_kernel<const E: u16>(
             if s.active {
                 s.active = false;
                 s.history = Vec3::ZERO;
-                s.force = Vec3::ZERO;
-                s.torque = Vec3::ZERO;
-                s.overlap = 0.0;
-                s.normal_force = 0.0;
             }
             s.onset = false;
             return;
@@ -710,8 +782,9 @@ fn wall_kernel<const E: u16>(
     s.onset = onset;
     let v_t = v_rel - v_n * n;
     if onset {
-        s.onset_normal_speed = v_n;
-        s.onset_tangential_speed = v_t.length();
+        detail.onset_normal_speed = v_n;
+        detail.onset_tangential_speed = v_t.length();
+        detail.point = point;
     }
     let (f_el, c_n, k_t) = law_at::<E>(
         &s.k,
@@ -752,18 +825,40 @@ fn wall_kernel<const E: u16>(
             torque -= m / w_mag * w_roll;
         }
     }
-    s.force = force;
-    s.torque = torque;
-    s.normal = n;
-    s.point = point;
-    s.overlap = overlap;
-    s.normal_force = f_n;
+    *o = WallOut { force, torque };
+    if c.shared.detail {
+        *detail = WallDetail {
+            normal: n,
+            point,
+            overlap,
+            normal_force: f_n,
+            ..*detail
+        };
+    }
 }
 
 /// Wall kernels of the particles of one chunk starting at `first` (their slots).
 #[inline(always)]
-fn wall_chunk<const E: u16>(c: &WallCtx<'_>, first: usize, slots: &mut [WallContact]) {
-    for (k, slots) in slots.chunks_exact_mut(c.wall_stride).enumerate() {
+fn wall_chunk<const E: u16>(
+    c: &WallCtx<'_>,
+    first: usize,
+    slots: &mut [WallContact],
+    out: &mut [WallOut],
+    detail: &mut [WallDetail],
+    batch: &mut Batch,
+) {
+    let stride = c.wall_stride;
+    if c.shared.batched && !on::<E>(c.shared.effects, Effect::RollingResistance) && stride <= BATCH
+    {
+        wall_chunk_batched::<E>(c, first, slots, out, detail, batch);
+        return;
+    }
+    for (k, ((slots, out), detail)) in slots
+        .chunks_exact_mut(stride)
+        .zip(out.chunks_exact_mut(stride))
+        .zip(detail.chunks_exact_mut(stride))
+        .enumerate()
+    {
         let i = first + k;
         if !c.alive[i] {
             continue;
@@ -773,11 +868,11 @@ fn wall_chunk<const E: u16>(c: &WallCtx<'_>, first: usize, slots: &mut [WallCont
             c.shared.velocity[i],
             c.shared.omega[i],
         );
-        for s in slots.iter_mut() {
+        for ((s, o), d) in slots.iter_mut().zip(out.iter_mut()).zip(detail.iter_mut()) {
             if s.wall == NO_WALL {
                 break;
             }
-            wall_kernel::<E>(s, i, x, v, w, c);
+            wall_kernel::<E>(s, o, d, i, x, v, w, c);
         }
     }
 }
@@ -796,6 +891,7 @@ fn particle_chunk<const E: u16>(
     coordination: &mut [u32],
     wall_coordination: &mut [u32],
     slots: &[WallContact],
+    wall_out: &[WallOut],
 ) -> (f64, bool, u32) {
     let rotation = on::<E>(c.effects, Effect::Rotation);
     let rolling = on::<E>(c.effects, Effect::RollingResistance);
@@ -825,7 +921,12 @@ fn particle_chunk<const E: u16>(
     let (force_sum, coordination) = (&mut force_sum[..len], &mut coordination[..len]);
     let wall_coordination = &mut wall_coordination[..len];
     let stride = c.wall_stride;
-    for (k, slots) in slots.chunks_exact(stride).take(len).enumerate() {
+    for (k, (slots, outs)) in slots
+        .chunks_exact(stride)
+        .zip(wall_out.chunks_exact(stride))
+        .take(len)
+        .enumerate()
+    {
         if !alive[k] {
             continue;
         }
@@ -835,33 +936,33 @@ fn particle_chunk<const E: u16>(
         // pairs in increasing index order: first those where the particle is j (their i is
         // smaller, so their indices come first), listed in the CSR ...
         for &e in &c.csr_entry[offset[k] as usize..offset[k + 1] as usize] {
-            let p = &c.pair_out[e as usize];
-            if !(p.overlap > 0.0) {
+            if !c.pair_active[e as usize] {
                 continue;
             }
+            let p = &c.pair_out[e as usize];
             z += 1;
             f -= p.force;
             if rotation {
                 let arm = radius[k] - 0.5 * p.overlap;
                 t += arm * p.torque_per_arm;
                 if rolling {
-                    t -= c.pairs[e as usize].rolling_torque;
+                    t -= c.pair_rolling[e as usize];
                 }
             }
         }
         // ... then those where it is i: a contiguous range of the sorted pair list
         for e in pair_start[k] as usize..pair_start[k + 1] as usize {
-            let p = &c.pair_out[e];
-            if !(p.overlap > 0.0) {
+            if !c.pair_active[e] {
                 continue;
             }
+            let p = &c.pair_out[e];
             z += 1;
             f += p.force;
             if rotation {
                 let arm = radius[k] - 0.5 * p.overlap;
                 t += arm * p.torque_per_arm;
                 if rolling {
-                    t += c.pairs[e].rolling_torque;
+                    t += c.pair_rolling[e];
                 }
             }
         }
@@ -870,7 +971,7 @@ fn particle_chunk<const E: u16>(
             f.z = 0.0;
         }
         let mut zw = 0u32;
-        for s in slots.iter() {
+        for (s, o) in slots.iter().zip(outs) {
             if s.wall == NO_WALL {
                 break;
             }
@@ -879,8 +980,8 @@ fn particle_chunk<const E: u16>(
                 if s.onset {
                     wall_onsets += 1;
                 }
-                f += s.force;
-                t += s.torque;
+                f += o.force;
+                t += o.torque;
             }
         }
         let (x, v, w) = (position[k], velocity[k], omega[k]);
@@ -1005,6 +1106,7 @@ impl Simulation {
             skin,
             threads: scene.threads,
             avx2: cpu_has_avx2(),
+            batched: true,
             record_every: scene.record_every,
             record_onsets: scene.record_onsets,
             removal_plane: scene.removal_plane.map(|(p, n)| (p, n / n.length())),
@@ -1015,9 +1117,15 @@ impl Simulation {
             time: 0.0,
             steps: 0,
             pairs: Vec::new(),
+            pair_active: Vec::new(),
             pair_out: Vec::new(),
+            pair_detail: Vec::new(),
+            pair_rolling: Vec::new(),
             pair_const: Vec::new(),
             wall_slots: Vec::new(),
+            wall_out: Vec::new(),
+            wall_detail: Vec::new(),
+            detail: true,
             wall_stride: 1,
             reference_position: p.position.clone(),
             reference_wall_offset: vec![Vec3::ZERO; scene.walls.len()],
@@ -1028,6 +1136,7 @@ impl Simulation {
             grid: CellGrid::default(),
             candidate_scratch: Vec::new(),
             old_pairs: Vec::new(),
+            old_pair_active: Vec::new(),
             old_slots: Vec::new(),
             wall_state: vec![WallState::default(); scene.walls.len()],
             chunk_onsets: Vec::new(),
@@ -1103,6 +1212,11 @@ impl Simulation {
         let n = self.position.len();
         self.pair_out.clear();
         self.pair_out.resize(self.pairs.len(), PairOut::default());
+        self.pair_detail.clear();
+        self.pair_detail
+            .resize(self.pairs.len(), PairDetail::default());
+        self.pair_rolling.clear();
+        self.pair_rolling.resize(self.pairs.len(), Vec3::ZERO);
         self.csr_offset.clear();
         self.csr_offset.resize(n + 1, 0);
         self.pair_start.clear();
@@ -1124,10 +1238,15 @@ impl Simulation {
         }
     }
 
-    /// Derived per-contact data: r_i + r_j of each pair and the law constants of every pair
-    /// and wall slot. A pure function of the lists and the static data (run after a rebuild
-    /// and a restore).
+    /// Derived per-contact data: r_i + r_j of each pair, the law constants of every pair
+    /// and wall slot, and the wall slots' output arrays. A pure function of the lists and the
+    /// static data (run after a rebuild and a restore).
     pub(crate) fn refresh_contact_constants(&mut self) {
+        let n_slots = self.wall_slots.len();
+        self.wall_out.clear();
+        self.wall_out.resize(n_slots, WallOut::default());
+        self.wall_detail.clear();
+        self.wall_detail.resize(n_slots, WallDetail::default());
         let nm = self.n_materials;
         self.pair_const.clear();
         for p in self.pairs.iter_mut() {
@@ -1173,7 +1292,9 @@ impl Simulation {
             &mut self.candidate_scratch,
         );
         std::mem::swap(&mut self.pairs, &mut self.old_pairs);
+        std::mem::swap(&mut self.pair_active, &mut self.old_pair_active);
         self.pairs.clear();
+        self.pair_active.clear();
         let mut old = 0usize;
         for &(i, j) in &self.candidate_scratch {
             // both lists are sorted by (i, j): merge to carry the state of surviving pairs
@@ -1186,12 +1307,14 @@ impl Simulation {
                 && (self.old_pairs[old].i, self.old_pairs[old].j) == (i, j)
             {
                 self.pairs.push(self.old_pairs[old]);
+                self.pair_active.push(self.old_pair_active[old]);
             } else {
                 self.pairs.push(PairContact {
                     i,
                     j,
                     ..Default::default()
                 });
+                self.pair_active.push(false);
             }
         }
         self.build_gather_lists();
@@ -1256,7 +1379,8 @@ impl Simulation {
         match self.pool.take() {
             Some(pool) if self.position.len() >= PARALLEL_MIN_PARTICLES => {
                 let r = pool.install(|| {
-                    for _ in 0..n {
+                    for k in 0..n {
+                        self.detail = k + 1 == n;
                         self.one_step(true)?;
                     }
                     Ok(())
@@ -1266,7 +1390,8 @@ impl Simulation {
             }
             other => {
                 self.pool = other;
-                for _ in 0..n {
+                for k in 0..n {
+                    self.detail = k + 1 == n;
                     self.one_step(false)?;
                 }
                 Ok(())
@@ -1327,6 +1452,9 @@ impl Simulation {
                 effects: self.effects,
                 clamp: self.clamp,
                 dt: self.dt,
+                detail: self.detail,
+                avx2,
+                batched: self.batched,
             };
             let wall_ctx = WallCtx {
                 shared: pair_ctx,
@@ -1335,22 +1463,40 @@ impl Simulation {
                 wall_state: &self.wall_state,
                 wall_stride: stride,
             };
-            let kernel = |((chunk, out), konst): (
-                (&mut [PairContact], &mut [PairOut]),
-                &[ContactConst],
-            )|
-             -> u32 {
-                simd::pair::<E>(avx2, chunk, out, konst, &pair_ctx)
-            };
+            type PairChunk<'c> = (
+                (
+                    (
+                        ((&'c mut [PairContact], &'c mut [bool]), &'c mut [PairOut]),
+                        &'c mut [PairDetail],
+                    ),
+                    &'c mut [Vec3],
+                ),
+                &'c [ContactConst],
+            );
+            let kernel =
+                |(((((chunk, active), out), detail), rolling), konst): PairChunk<'_>| -> u32 {
+                    BATCH_SCRATCH.with_borrow_mut(|b| {
+                        simd::pair::<E>(
+                            avx2, chunk, active, out, detail, rolling, konst, &pair_ctx, b,
+                        )
+                    })
+                };
             let (pairs, pair_out, pair_const) =
                 (&mut self.pairs, &mut self.pair_out, &self.pair_const);
+            let (pair_detail, pair_rolling) = (&mut self.pair_detail, &mut self.pair_rolling);
+            let pair_active = &mut self.pair_active;
             let (onsets, slots) = (&mut self.chunk_onsets, &mut self.wall_slots);
+            let (wall_out, wall_detail) = (&mut self.wall_out, &mut self.wall_detail);
             if parallel {
+                let slot_chunk = PARTICLE_CHUNK * stride;
                 rayon::join(
                     || {
                         pairs
                             .par_chunks_mut(PAIR_CHUNK)
+                            .zip(pair_active.par_chunks_mut(PAIR_CHUNK))
                             .zip(pair_out.par_chunks_mut(PAIR_CHUNK))
+                            .zip(pair_detail.par_chunks_mut(PAIR_CHUNK))
+                            .zip(pair_rolling.par_chunks_mut(PAIR_CHUNK))
                             .zip(pair_const.par_chunks(PAIR_CHUNK))
                             .with_min_len(pair_min)
                             .map(kernel)
@@ -1358,11 +1504,15 @@ impl Simulation {
                     },
                     || {
                         slots
-                            .par_chunks_mut(PARTICLE_CHUNK * stride)
+                            .par_chunks_mut(slot_chunk)
+                            .zip(wall_out.par_chunks_mut(slot_chunk))
+                            .zip(wall_detail.par_chunks_mut(slot_chunk))
                             .enumerate()
                             .with_min_len(particle_min)
-                            .for_each(|(c, s)| {
-                                simd::wall::<E>(avx2, &wall_ctx, c * PARTICLE_CHUNK, s)
+                            .for_each(|(c, ((s, o), d))| {
+                                BATCH_SCRATCH.with_borrow_mut(|b| {
+                                    simd::wall::<E>(avx2, &wall_ctx, c * PARTICLE_CHUNK, s, o, d, b)
+                                })
                             })
                     },
                 );
@@ -1370,18 +1520,24 @@ impl Simulation {
                 onsets.clear();
                 for chunk in pairs
                     .chunks_mut(PAIR_CHUNK)
+                    .zip(pair_active.chunks_mut(PAIR_CHUNK))
                     .zip(pair_out.chunks_mut(PAIR_CHUNK))
+                    .zip(pair_detail.chunks_mut(PAIR_CHUNK))
+                    .zip(pair_rolling.chunks_mut(PAIR_CHUNK))
                     .zip(pair_const.chunks(PAIR_CHUNK))
                 {
                     onsets.push(kernel(chunk));
                 }
-                simd::wall::<E>(avx2, &wall_ctx, 0, slots);
+                BATCH_SCRATCH.with_borrow_mut(|b| {
+                    simd::wall::<E>(avx2, &wall_ctx, 0, slots, wall_out, wall_detail, b)
+                });
             }
         }
         // ---- particle phase: gather in list order, advance
         {
             let ctx = ParticleCtx {
-                pairs: &self.pairs,
+                pair_active: &self.pair_active,
+                pair_rolling: &self.pair_rolling,
                 pair_out: &self.pair_out,
                 csr_offset: &self.csr_offset,
                 csr_entry: &self.csr_entry,
@@ -1405,10 +1561,11 @@ impl Simulation {
                     .zip(self.coordination.par_chunks_mut(PARTICLE_CHUNK))
                     .zip(self.wall_coordination.par_chunks_mut(PARTICLE_CHUNK))
                     .zip(self.wall_slots.par_chunks(PARTICLE_CHUNK * stride))
+                    .zip(self.wall_out.par_chunks(PARTICLE_CHUNK * stride))
                     .enumerate()
                     .with_min_len(particle_min)
-                    .map(|(c, ((((((x, v), w), f), z), zw), s))| {
-                        simd::particle::<E>(avx2, &ctx, c * PARTICLE_CHUNK, x, v, w, f, z, zw, s)
+                    .map(|(c, (((((((x, v), w), f), z), zw), s), o))| {
+                        simd::particle::<E>(avx2, &ctx, c * PARTICLE_CHUNK, x, v, w, f, z, zw, s, o)
                     })
                     .collect_into_vec(&mut self.chunk_results);
             } else {
@@ -1422,8 +1579,9 @@ impl Simulation {
                     .zip(self.coordination.chunks_mut(PARTICLE_CHUNK))
                     .zip(self.wall_coordination.chunks_mut(PARTICLE_CHUNK))
                     .zip(self.wall_slots.chunks(PARTICLE_CHUNK * stride))
+                    .zip(self.wall_out.chunks(PARTICLE_CHUNK * stride))
                     .enumerate();
-                for (c, ((((((x, v), w), f), z), zw), s)) in iter {
+                for (c, (((((((x, v), w), f), z), zw), s), o)) in iter {
                     self.chunk_results.push(simd::particle::<E>(
                         avx2,
                         &ctx,
@@ -1435,6 +1593,7 @@ impl Simulation {
                         z,
                         zw,
                         s,
+                        o,
                     ));
                 }
             }
@@ -1485,15 +1644,18 @@ impl Simulation {
                 continue;
             }
             let end = ((c + 1) * PAIR_CHUNK).min(self.pairs.len());
-            for p in &self.pairs[c * PAIR_CHUNK..end] {
+            for (p, d) in self.pairs[c * PAIR_CHUNK..end]
+                .iter()
+                .zip(&self.pair_detail[c * PAIR_CHUNK..end])
+            {
                 if p.onset {
                     self.onsets.push(ContactOnset {
                         time,
                         step,
                         particle: p.i,
                         partner: Partner::Particle(p.j),
-                        normal_speed: p.onset_normal_speed,
-                        tangential_speed: p.onset_tangential_speed,
+                        normal_speed: d.onset_normal_speed,
+                        tangential_speed: d.onset_tangential_speed,
                         position: self.position_at_force_pass(p.i as usize),
                         partner_position: self.position_at_force_pass(p.j as usize),
                     });
@@ -1502,7 +1664,7 @@ impl Simulation {
         }
         if walls {
             let stride = self.wall_stride;
-            for (k, s) in self.wall_slots.iter().enumerate() {
+            for (k, (s, d)) in self.wall_slots.iter().zip(&self.wall_detail).enumerate() {
                 if s.wall != NO_WALL && s.onset {
                     let i = k / stride;
                     self.onsets.push(ContactOnset {
@@ -1510,10 +1672,10 @@ impl Simulation {
                         step,
                         particle: i as u32,
                         partner: Partner::Wall(s.wall),
-                        normal_speed: s.onset_normal_speed,
-                        tangential_speed: s.onset_tangential_speed,
+                        normal_speed: d.onset_normal_speed,
+                        tangential_speed: d.onset_tangential_speed,
                         position: self.position_at_force_pass(i),
-                        partner_position: s.point,
+                        partner_position: d.point,
                     });
                 }
             }
@@ -1541,34 +1703,42 @@ impl Simulation {
         }
     }
 
-    /// Active contacts at the last force evaluation.
+    /// Active contacts at the last force evaluation (empty right after a checkpoint restore,
+    /// whose contacts have not been evaluated yet, apart from their flags).
     pub fn contacts(&self) -> Vec<ContactRecord> {
         let mut out = Vec::new();
-        for p in &self.pairs {
-            if p.active {
+        let pairs = self.pairs.iter().zip(&self.pair_active);
+        for (((p, &active), o), d) in pairs.zip(&self.pair_out).zip(&self.pair_detail) {
+            if active && o.overlap > 0.0 {
                 let i = p.i as usize;
                 let x_i = self.position[i] - self.velocity[i] * self.dt;
                 out.push(ContactRecord {
                     particle: p.i,
                     partner: Partner::Particle(p.j),
-                    normal: p.normal,
-                    normal_force: p.normal_force,
-                    tangential_force: p.force + p.normal_force * p.normal,
-                    overlap: p.overlap,
-                    point: x_i + (self.radius[i] - 0.5 * p.overlap) * p.normal,
+                    normal: d.normal,
+                    normal_force: d.normal_force,
+                    tangential_force: o.force + d.normal_force * d.normal,
+                    overlap: o.overlap,
+                    point: x_i + (self.radius[i] - 0.5 * o.overlap) * d.normal,
                 });
             }
         }
-        for (k, s) in self.wall_slots.iter().enumerate() {
-            if s.wall != NO_WALL && s.active {
+        for (k, ((s, o), d)) in self
+            .wall_slots
+            .iter()
+            .zip(&self.wall_out)
+            .zip(&self.wall_detail)
+            .enumerate()
+        {
+            if s.wall != NO_WALL && s.active && d.overlap > 0.0 {
                 out.push(ContactRecord {
                     particle: (k / self.wall_stride) as u32,
                     partner: Partner::Wall(s.wall),
-                    normal: s.normal,
-                    normal_force: s.normal_force,
-                    tangential_force: s.force + s.normal_force * s.normal,
-                    overlap: s.overlap,
-                    point: s.point,
+                    normal: d.normal,
+                    normal_force: d.normal_force,
+                    tangential_force: o.force + d.normal_force * d.normal,
+                    overlap: d.overlap,
+                    point: d.point,
                 });
             }
         }
@@ -1606,6 +1776,19 @@ impl Simulation {
         self.avx2
     }
 
+    /// Evaluate contacts in batches (`true`, the default; see the module documentation) or
+    /// one at a time (`false`, the reference kernels). Both give bitwise the same results (a
+    /// test checks it); this exists to compare their speed and to test that. Scenes with
+    /// rolling resistance always run one at a time.
+    pub fn set_batched(&mut self, on: bool) {
+        self.batched = on;
+    }
+
+    /// Whether contacts are evaluated in batches (see [`Simulation::set_batched`]).
+    pub fn uses_batches(&self) -> bool {
+        self.batched
+    }
+
     /// Worker threads the simulation was built with.
     pub fn threads(&self) -> usize {
         self.threads
@@ -1617,6 +1800,12 @@ impl Simulation {
     /// Number of neighbour-list rebuilds so far.
     pub fn rebuilds(&self) -> u64 {
         self.rebuilds
+    }
+    /// Candidate pairs in the Verlet list and particle–wall slots in use (a measure of the
+    /// neighbour-list work per step).
+    pub fn candidate_counts(&self) -> (usize, usize) {
+        let slots = self.wall_slots.iter().filter(|s| s.wall != NO_WALL).count();
+        (self.pairs.len(), slots)
     }
     /// Number of particles (alive or not).
     pub fn len(&self) -> usize {
@@ -1779,16 +1968,18 @@ impl Simulation {
     /// Largest particle–particle or particle–wall overlap at the last step, m.
     pub fn max_overlap(&self) -> f64 {
         let a = self
-            .pairs
+            .pair_active
             .iter()
-            .filter(|p| p.active)
-            .map(|p| p.overlap)
+            .zip(&self.pair_out)
+            .filter(|(&active, _)| active)
+            .map(|(_, o)| o.overlap)
             .fold(0.0, f64::max);
         let b = self
             .wall_slots
             .iter()
-            .filter(|s| s.wall != NO_WALL && s.active)
-            .map(|s| s.overlap)
+            .zip(&self.wall_detail)
+            .filter(|(s, _)| s.wall != NO_WALL && s.active)
+            .map(|(_, d)| d.overlap)
             .fold(0.0, f64::max);
         a.max(b)
     }

@@ -1,0 +1,651 @@
+//! Batched contact kernels: the pairs of a chunk, or the wall slots of a chunk of particles,
+//! evaluated up to [`BATCH`] at a time in short passes (find and gather, geometry, laws,
+//! forces, scatter), the geometry and force passes four contacts per instruction with AVX2.
+//! Every contact goes through the IEEE operations of the one-at-a-time kernels
+//! ([`super::pair_kernel`], [`super::wall_kernel`]) in their order, so results are bitwise
+//! theirs (`tests/dem_determinism.rs` checks it on both builds).
+
+use super::*;
+
+/// Contacts handled together by the batched kernels ([`pair_chunk`], [`wall_chunk`]).
+pub(super) const BATCH: usize = 64;
+
+/// Three components of up to [`BATCH`] vectors, each in its own array, so the elementwise
+/// loops over a batch compile to packed (SIMD) arithmetic.
+#[derive(Clone, Copy)]
+struct Lanes3 {
+    x: [f64; BATCH],
+    y: [f64; BATCH],
+    z: [f64; BATCH],
+}
+
+impl Lanes3 {
+    const ZERO: Self = Lanes3 {
+        x: [0.0; BATCH],
+        y: [0.0; BATCH],
+        z: [0.0; BATCH],
+    };
+
+    #[inline(always)]
+    fn get(&self, k: usize) -> Vec3 {
+        Vec3::new(self.x[k], self.y[k], self.z[k])
+    }
+
+    #[inline(always)]
+    fn set(&mut self, k: usize, v: Vec3) {
+        self.x[k] = v.x;
+        self.y[k] = v.y;
+        self.z[k] = v.z;
+    }
+}
+
+/// Up to [`BATCH`] contacts (pairs or wall slots) in flight. The batched kernels run in
+/// passes over it: find the contacts and gather their inputs, evaluate the normal laws,
+/// evaluate the forces ([`contact_forces`]), scatter the results. Each pass is a short loop
+/// whose iterations are independent, so the processor overlaps many contacts (and the force
+/// pass is packed SIMD), where the one-contact-at-a-time kernel is one long dependency chain
+/// per contact. Every contact goes through the same IEEE operations in the same order as in
+/// [`pair_kernel`] and [`wall_kernel`], so the results are bitwise theirs.
+pub(super) struct Batch {
+    len: usize,
+    /// Index of the contact in its chunk (pair or slot).
+    index: [u32; BATCH],
+    /// Unit normal, from the particle (pair: i) towards the partner; for pairs, x_j − x_i
+    /// until [`pair_geometry`] normalises it.
+    n: Lanes3,
+    /// Overlap δ, m; for pairs, |x_j − x_i|² until [`pair_geometry`].
+    overlap: [f64; BATCH],
+    /// Pairs: r_i + r_j, r_i, r_j (m), ω_i, ω_j (rad/s), from which [`pair_geometry`] makes
+    /// the overlap, the normal and `spin`.
+    r_sum: [f64; BATCH],
+    r_i: [f64; BATCH],
+    r_j: [f64; BATCH],
+    omega_i: Lanes3,
+    omega_j: Lanes3,
+    /// Lever arm of the particle (walls), m.
+    arm: [f64; BATCH],
+    /// Relative translational velocity of the particle (pair: i) against the partner, m/s.
+    v_rel: Lanes3,
+    /// Σ arm ω (pair: arm_i ω_i + arm_j ω_j; wall: arm ω), m/s; its cross product with n is
+    /// the rotational part of the relative velocity.
+    spin: Lanes3,
+    /// Mindlin spring ξ, m: read and written by the force pass.
+    history: Lanes3,
+    /// Law values at δ: elastic normal force (N), damping (N·s/m), tangential stiffness (N/m);
+    /// for a Hertz contact whose `hertz` mask is set, the constants `f_el`, `c_n`, `k_t` of
+    /// its [`ContactConst`] instead, and the AVX2 force pass evaluates the law.
+    f_el: [f64; BATCH],
+    c_n: [f64; BATCH],
+    k_t: [f64; BATCH],
+    ct_ratio: [f64; BATCH],
+    mu: [f64; BATCH],
+    /// All bits set where `f_el`, `c_n`, `k_t` hold Hertz constants, not law values.
+    hertz: [u64; BATCH],
+    // ---- results
+    /// Force on the particle (pair: i), N.
+    force: Lanes3,
+    /// n × f_t (the torque per unit arm), N.
+    torque_per_arm: Lanes3,
+    f_n: [f64; BATCH],
+    v_n: [f64; BATCH],
+    v_t: Lanes3,
+}
+
+thread_local! {
+    /// Each thread's batch (16 kB), reused by every chunk it runs.
+    pub(super) static BATCH_SCRATCH: std::cell::RefCell<Batch> = const { std::cell::RefCell::new(Batch::EMPTY) };
+}
+
+impl Batch {
+    const EMPTY: Batch = Batch {
+        len: 0,
+        index: [0; BATCH],
+        n: Lanes3::ZERO,
+        overlap: [0.0; BATCH],
+        r_sum: [0.0; BATCH],
+        r_i: [0.0; BATCH],
+        r_j: [0.0; BATCH],
+        omega_i: Lanes3::ZERO,
+        omega_j: Lanes3::ZERO,
+        arm: [0.0; BATCH],
+        v_rel: Lanes3::ZERO,
+        spin: Lanes3::ZERO,
+        history: Lanes3::ZERO,
+        f_el: [0.0; BATCH],
+        c_n: [0.0; BATCH],
+        k_t: [0.0; BATCH],
+        ct_ratio: [0.0; BATCH],
+        mu: [0.0; BATCH],
+        hertz: [0; BATCH],
+        force: Lanes3::ZERO,
+        torque_per_arm: Lanes3::ZERO,
+        f_n: [0.0; BATCH],
+        v_n: [0.0; BATCH],
+        v_t: Lanes3::ZERO,
+    };
+
+    /// Law values of contact `k` from its constants at its overlap.
+    #[inline(always)]
+    fn set_law<const E: u16>(&mut self, k: usize, konst: &ContactConst, c: &PairCtx<'_>) {
+        let hertz = c.avx2 && konst.kind == LawKind::Hertz;
+        self.hertz[k] = if hertz { u64::MAX } else { 0 };
+        let (f_el, c_n, k_t) = if hertz {
+            (konst.f_el, konst.c_n, konst.k_t)
+        } else {
+            law_at::<E>(konst, c.model, c.laws, c.effects, self.overlap[k])
+        };
+        self.f_el[k] = f_el;
+        self.c_n[k] = c_n;
+        self.k_t[k] = k_t;
+        self.ct_ratio[k] = konst.ct_ratio;
+        self.mu[k] = konst.mu;
+    }
+}
+
+/// Overlap, unit normal and spin of the pairs of a batch from their centre distance: the
+/// operations of [`pair_kernel`] in its order.
+#[inline(always)]
+fn pair_geometry<const E: u16>(b: &mut Batch, c: &PairCtx<'_>) {
+    #[cfg(target_arch = "x86_64")]
+    if c.avx2 {
+        // SAFETY: `avx2` is set only when the CPU reported AVX2.
+        unsafe { avx2_forces::pair_geometry::<E>(b, c) };
+        return;
+    }
+    let rotation = on::<E>(c.effects, Effect::Rotation);
+    for k in 0..b.len.min(BATCH) {
+        let d = b.n.get(k);
+        let dist = b.overlap[k].sqrt();
+        // rounding can give dist = r_sum for dist² just below r_sum²; keep the overlap
+        // positive, the gather's activity test
+        let overlap = (b.r_sum[k] - dist).max(f64::MIN_POSITIVE);
+        b.n.set(k, d * (1.0 / dist));
+        b.overlap[k] = overlap;
+        if rotation {
+            let arm_i = b.r_i[k] - 0.5 * overlap;
+            let arm_j = b.r_j[k] - 0.5 * overlap;
+            b.spin
+                .set(k, arm_i * b.omega_i.get(k) + arm_j * b.omega_j.get(k));
+        }
+    }
+}
+
+/// Force pass of a batch: normal force with damping and clamp, Mindlin tangential force with
+/// the Coulomb cap, n × f_t; the operations of [`pair_kernel`] and [`wall_kernel`] in their
+/// order. Branch-free apart from effect tests that are constant over the batch.
+#[inline(always)]
+fn contact_forces<const E: u16>(b: &mut Batch, c: &PairCtx<'_>) {
+    #[cfg(target_arch = "x86_64")]
+    if c.avx2 {
+        // SAFETY: `avx2` is set only when the CPU reported AVX2.
+        unsafe { avx2_forces::contact_forces::<E>(b, c) };
+        return;
+    }
+    let rotation = on::<E>(c.effects, Effect::Rotation);
+    let friction = on::<E>(c.effects, Effect::Friction);
+    let (clamp, dt) = (c.clamp, c.dt);
+    for k in 0..b.len.min(BATCH) {
+        let n = b.n.get(k);
+        let mut v_rel = b.v_rel.get(k);
+        if rotation {
+            v_rel += b.spin.get(k).cross(n);
+        }
+        let v_n = v_rel.dot(n);
+        let v_t = v_rel - v_n * n;
+        let c_n = b.c_n[k];
+        let f_n = b.f_el[k] + c_n * v_n;
+        let f_n = if clamp && f_n < 0.0 { 0.0 } else { f_n };
+        let mut force = -f_n * n;
+        let mut torque_per_arm = Vec3::ZERO;
+        if friction {
+            // `tangential_force` with its branches turned into selects
+            let k_t = b.k_t[k];
+            let c_t = c_n * b.ct_ratio[k];
+            let cap = b.mu[k] * f_n.max(0.0);
+            let mut xi = b.history.get(k);
+            xi -= xi.dot(n) * n;
+            xi += v_t * dt;
+            let f_stick = -k_t * xi - c_t * v_t;
+            let f2 = f_stick.length_squared();
+            let sliding = f2 > cap * cap;
+            let f_slide = f_stick * (cap / f2.sqrt());
+            let inv = -1.0 / k_t;
+            let xi_slide = if k_t > 0.0 { f_slide * inv } else { Vec3::ZERO };
+            let f_t = select3(sliding, f_slide, f_stick);
+            b.history.set(k, select3(sliding, xi_slide, xi));
+            force += f_t;
+            if rotation {
+                torque_per_arm = n.cross(f_t);
+            }
+        }
+        b.force.set(k, force);
+        b.torque_per_arm.set(k, torque_per_arm);
+        b.f_n[k] = f_n;
+        b.v_n[k] = v_n;
+        b.v_t.set(k, v_t);
+    }
+}
+
+/// [`contact_forces`] on four contacts per instruction (AVX2). The lanes past the batch's
+/// length compute on stale values that nothing reads.
+#[cfg(target_arch = "x86_64")]
+mod avx2_forces {
+    use super::*;
+    use std::arch::x86_64::*;
+
+    /// Three-component vectors of four lanes, with glam's formulas for the products.
+    #[derive(Clone, Copy)]
+    struct V4 {
+        x: __m256d,
+        y: __m256d,
+        z: __m256d,
+    }
+
+    #[inline(always)]
+    unsafe fn load(l: &Lanes3, k: usize) -> V4 {
+        V4 {
+            x: _mm256_loadu_pd(l.x.as_ptr().add(k)),
+            y: _mm256_loadu_pd(l.y.as_ptr().add(k)),
+            z: _mm256_loadu_pd(l.z.as_ptr().add(k)),
+        }
+    }
+
+    #[inline(always)]
+    unsafe fn store(l: &mut Lanes3, k: usize, v: V4) {
+        _mm256_storeu_pd(l.x.as_mut_ptr().add(k), v.x);
+        _mm256_storeu_pd(l.y.as_mut_ptr().add(k), v.y);
+        _mm256_storeu_pd(l.z.as_mut_ptr().add(k), v.z);
+    }
+
+    #[inline(always)]
+    unsafe fn ld(a: &[f64; BATCH], k: usize) -> __m256d {
+        _mm256_loadu_pd(a.as_ptr().add(k))
+    }
+
+    #[inline(always)]
+    unsafe fn st(a: &mut [f64; BATCH], k: usize, v: __m256d) {
+        _mm256_storeu_pd(a.as_mut_ptr().add(k), v)
+    }
+
+    #[inline(always)]
+    unsafe fn add(a: V4, b: V4) -> V4 {
+        V4 {
+            x: _mm256_add_pd(a.x, b.x),
+            y: _mm256_add_pd(a.y, b.y),
+            z: _mm256_add_pd(a.z, b.z),
+        }
+    }
+
+    #[inline(always)]
+    unsafe fn sub(a: V4, b: V4) -> V4 {
+        V4 {
+            x: _mm256_sub_pd(a.x, b.x),
+            y: _mm256_sub_pd(a.y, b.y),
+            z: _mm256_sub_pd(a.z, b.z),
+        }
+    }
+
+    /// s v (glam's `f64 * DVec3`).
+    #[inline(always)]
+    unsafe fn scale(s: __m256d, v: V4) -> V4 {
+        V4 {
+            x: _mm256_mul_pd(s, v.x),
+            y: _mm256_mul_pd(s, v.y),
+            z: _mm256_mul_pd(s, v.z),
+        }
+    }
+
+    /// (a.x b.x + a.y b.y) + a.z b.z, glam's `dot`.
+    #[inline(always)]
+    unsafe fn dot(a: V4, b: V4) -> __m256d {
+        _mm256_add_pd(
+            _mm256_add_pd(_mm256_mul_pd(a.x, b.x), _mm256_mul_pd(a.y, b.y)),
+            _mm256_mul_pd(a.z, b.z),
+        )
+    }
+
+    /// glam's `cross`: (a.y b.z − b.y a.z, a.z b.x − b.z a.x, a.x b.y − b.x a.y).
+    #[inline(always)]
+    unsafe fn cross(a: V4, b: V4) -> V4 {
+        V4 {
+            x: _mm256_sub_pd(_mm256_mul_pd(a.y, b.z), _mm256_mul_pd(b.y, a.z)),
+            y: _mm256_sub_pd(_mm256_mul_pd(a.z, b.x), _mm256_mul_pd(b.z, a.x)),
+            z: _mm256_sub_pd(_mm256_mul_pd(a.x, b.y), _mm256_mul_pd(b.x, a.y)),
+        }
+    }
+
+    /// `if m { a } else { b }` per lane and component.
+    #[inline(always)]
+    unsafe fn select(m: __m256d, a: V4, b: V4) -> V4 {
+        V4 {
+            x: _mm256_blendv_pd(b.x, a.x, m),
+            y: _mm256_blendv_pd(b.y, a.y, m),
+            z: _mm256_blendv_pd(b.z, a.z, m),
+        }
+    }
+
+    #[target_feature(enable = "avx2")]
+    pub(super) unsafe fn pair_geometry<const E: u16>(b: &mut Batch, c: &PairCtx<'_>) {
+        let rotation = on::<E>(c.effects, Effect::Rotation);
+        let one = _mm256_set1_pd(1.0);
+        let half = _mm256_set1_pd(0.5);
+        let min_positive = _mm256_set1_pd(f64::MIN_POSITIVE);
+        let len = b.len.min(BATCH);
+        let mut k = 0;
+        while k < len {
+            let d = load(&b.n, k);
+            let dist = _mm256_sqrt_pd(ld(&b.overlap, k));
+            // f64::max(x, MIN_POSITIVE): maxpd returns its second operand for NaN, as max does
+            let overlap = _mm256_max_pd(_mm256_sub_pd(ld(&b.r_sum, k), dist), min_positive);
+            store(&mut b.n, k, scale(_mm256_div_pd(one, dist), d));
+            st(&mut b.overlap, k, overlap);
+            if rotation {
+                let h = _mm256_mul_pd(half, overlap);
+                let arm_i = _mm256_sub_pd(ld(&b.r_i, k), h);
+                let arm_j = _mm256_sub_pd(ld(&b.r_j, k), h);
+                let spin = add(
+                    scale(arm_i, load(&b.omega_i, k)),
+                    scale(arm_j, load(&b.omega_j, k)),
+                );
+                store(&mut b.spin, k, spin);
+            }
+            k += 4;
+        }
+    }
+
+    #[target_feature(enable = "avx2")]
+    pub(super) unsafe fn contact_forces<const E: u16>(b: &mut Batch, c: &PairCtx<'_>) {
+        let rotation = on::<E>(c.effects, Effect::Rotation);
+        let friction = on::<E>(c.effects, Effect::Friction);
+        let damping = on::<E>(c.effects, Effect::Damping);
+        let zero = _mm256_setzero_pd();
+        let sign = _mm256_set1_pd(-0.0);
+        let dt = _mm256_set1_pd(c.dt);
+        let minus_one = _mm256_set1_pd(-1.0);
+        let len = b.len.min(BATCH);
+        let mut k = 0;
+        while k < len {
+            let n = load(&b.n, k);
+            let mut v_rel = load(&b.v_rel, k);
+            if rotation {
+                v_rel = add(v_rel, cross(load(&b.spin, k), n));
+            }
+            let v_n = dot(v_rel, n);
+            let v_t = sub(v_rel, scale(v_n, n));
+            // the Hertz law where the lanes hold its constants (`law_at`'s operations)
+            let hertz =
+                _mm256_castsi256_pd(_mm256_loadu_si256(b.hertz.as_ptr().add(k) as *const __m256i));
+            let overlap = ld(&b.overlap, k);
+            let sq = _mm256_sqrt_pd(overlap);
+            let (f_el, c_n, k_t) = (ld(&b.f_el, k), ld(&b.c_n, k), ld(&b.k_t, k));
+            let f_el =
+                _mm256_blendv_pd(f_el, _mm256_mul_pd(_mm256_mul_pd(f_el, sq), overlap), hertz);
+            let c_n = if damping {
+                _mm256_blendv_pd(c_n, _mm256_mul_pd(c_n, _mm256_sqrt_pd(sq)), hertz)
+            } else {
+                _mm256_andnot_pd(hertz, c_n)
+            };
+            let k_t = _mm256_blendv_pd(k_t, _mm256_mul_pd(k_t, sq), hertz);
+            let mut f_n = _mm256_add_pd(f_el, _mm256_mul_pd(c_n, v_n));
+            if c.clamp {
+                // f_n < 0 → 0 (NaN stays)
+                let neg = _mm256_cmp_pd::<_CMP_LT_OQ>(f_n, zero);
+                f_n = _mm256_blendv_pd(f_n, zero, neg);
+            }
+            let mut force = scale(_mm256_xor_pd(f_n, sign), n);
+            let mut torque_per_arm = V4 {
+                x: zero,
+                y: zero,
+                z: zero,
+            };
+            if friction {
+                let c_t = _mm256_mul_pd(c_n, ld(&b.ct_ratio, k));
+                // f64::max(f_n, 0): 0 for NaN, as maxpd returns its second operand then
+                let cap = _mm256_mul_pd(ld(&b.mu, k), _mm256_max_pd(f_n, zero));
+                let mut xi = load(&b.history, k);
+                xi = sub(xi, scale(dot(xi, n), n));
+                xi = add(xi, scale(dt, v_t));
+                let f_stick = sub(scale(_mm256_xor_pd(k_t, sign), xi), scale(c_t, v_t));
+                let f2 = dot(f_stick, f_stick);
+                let sliding = _mm256_cmp_pd::<_CMP_GT_OQ>(f2, _mm256_mul_pd(cap, cap));
+                let f_slide = scale(_mm256_div_pd(cap, _mm256_sqrt_pd(f2)), f_stick);
+                let inv = _mm256_div_pd(minus_one, k_t);
+                let stiff = _mm256_cmp_pd::<_CMP_GT_OQ>(k_t, zero);
+                let xi_slide = V4 {
+                    x: _mm256_and_pd(_mm256_mul_pd(f_slide.x, inv), stiff),
+                    y: _mm256_and_pd(_mm256_mul_pd(f_slide.y, inv), stiff),
+                    z: _mm256_and_pd(_mm256_mul_pd(f_slide.z, inv), stiff),
+                };
+                let f_t = select(sliding, f_slide, f_stick);
+                store(&mut b.history, k, select(sliding, xi_slide, xi));
+                force = add(force, f_t);
+                if rotation {
+                    torque_per_arm = cross(n, f_t);
+                }
+            }
+            store(&mut b.force, k, force);
+            store(&mut b.torque_per_arm, k, torque_per_arm);
+            st(&mut b.f_n, k, f_n);
+            st(&mut b.v_n, k, v_n);
+            store(&mut b.v_t, k, v_t);
+            k += 4;
+        }
+    }
+}
+
+/// `if m { a } else { b }` per component, written so that it compiles to a blend.
+#[inline(always)]
+fn select3(m: bool, a: Vec3, b: Vec3) -> Vec3 {
+    Vec3::new(
+        if m { a.x } else { b.x },
+        if m { a.y } else { b.y },
+        if m { a.z } else { b.z },
+    )
+}
+
+/// The pairs of one chunk in batches (see [`Batch`]); returns the number of onsets.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub(super) fn pair_chunk_batched<const E: u16>(
+    chunk: &mut [PairContact],
+    active: &mut [bool],
+    out: &mut [PairOut],
+    detail: &mut [PairDetail],
+    konst: &[ContactConst],
+    c: &PairCtx<'_>,
+    b: &mut Batch,
+) -> u32 {
+    let rotation = on::<E>(c.effects, Effect::Rotation);
+    let mut onsets = 0u32;
+    let len = chunk.len();
+    let (active, out, detail, konst) = (
+        &mut active[..len],
+        &mut out[..len],
+        &mut detail[..len],
+        &konst[..len],
+    );
+    let mut next = 0usize;
+    while next < len {
+        // ---- find the pairs in contact (and end the contacts that stopped)
+        b.len = 0;
+        while next < len && b.len < BATCH {
+            let e = next;
+            next += 1;
+            let p = &mut chunk[e];
+            let (i, j) = (p.i as usize, p.j as usize);
+            let d = c.position[j] - c.position[i];
+            let dist2 = d.length_squared();
+            let r_sum = p.r_sum;
+            if dist2 >= r_sum * r_sum || dist2 == 0.0 {
+                if active[e] {
+                    active[e] = false;
+                    p.onset = false;
+                    p.history = Vec3::ZERO;
+                    out[e].overlap = 0.0;
+                }
+                continue;
+            }
+            let k = b.len;
+            b.len += 1;
+            b.index[k] = e as u32;
+            b.n.set(k, d);
+            b.overlap[k] = dist2;
+            b.r_sum[k] = r_sum;
+            b.v_rel.set(k, c.velocity[i] - c.velocity[j]);
+            if rotation {
+                b.r_i[k] = c.radius[i];
+                b.r_j[k] = c.radius[j];
+                b.omega_i.set(k, c.omega[i]);
+                b.omega_j.set(k, c.omega[j]);
+            }
+            b.history.set(k, p.history);
+        }
+        // ---- overlaps and normals, laws, forces
+        pair_geometry::<E>(b, c);
+        for k in 0..b.len {
+            b.set_law::<E>(k, &konst[b.index[k] as usize], c);
+        }
+        contact_forces::<E>(b, c);
+        // ---- scatter
+        for k in 0..b.len {
+            let e = b.index[k] as usize;
+            let p = &mut chunk[e];
+            let onset = !active[e];
+            active[e] = true;
+            p.onset = onset;
+            p.history = b.history.get(k);
+            let n = b.n.get(k);
+            let d = &mut detail[e];
+            if onset {
+                onsets += 1;
+                d.onset_normal_speed = b.v_n[k];
+                d.onset_tangential_speed = b.v_t.get(k).length();
+            }
+            if c.detail {
+                d.normal = n;
+                d.normal_force = b.f_n[k];
+            }
+            out[e] = PairOut {
+                force: b.force.get(k),
+                torque_per_arm: b.torque_per_arm.get(k),
+                overlap: b.overlap[k],
+            };
+        }
+    }
+    onsets
+}
+
+/// The wall slots of one chunk of particles starting at `first`, in batches (see [`Batch`]).
+#[inline(always)]
+pub(super) fn wall_chunk_batched<const E: u16>(
+    c: &WallCtx<'_>,
+    first: usize,
+    slots: &mut [WallContact],
+    out: &mut [WallOut],
+    detail: &mut [WallDetail],
+    b: &mut Batch,
+) {
+    let moving = on::<E>(c.shared.effects, Effect::MovingWalls);
+    let rotation = on::<E>(c.shared.effects, Effect::Rotation);
+    let belt = on::<E>(c.shared.effects, Effect::Belt);
+    let stride = c.wall_stride;
+    let n_slots = slots.len();
+    let (out, detail) = (&mut out[..n_slots], &mut detail[..n_slots]);
+    let mut next = 0usize;
+    let mut particle = first;
+    while next < n_slots {
+        // ---- find the slots in contact, particle by particle
+        b.len = 0;
+        while next < n_slots && b.len + stride <= BATCH {
+            let first_slot = next;
+            next += stride;
+            let i = particle;
+            particle += 1;
+            if !c.alive[i] {
+                continue;
+            }
+            let (x, v, w) = (
+                c.shared.position[i],
+                c.shared.velocity[i],
+                c.shared.omega[i],
+            );
+            let r = c.shared.radius[i];
+            for q in first_slot..first_slot + stride {
+                let s = &mut slots[q];
+                if s.wall == NO_WALL {
+                    break;
+                }
+                let wall = &c.walls[s.wall as usize];
+                let ws = if moving {
+                    c.wall_state[s.wall as usize]
+                } else {
+                    WallState::default()
+                };
+                let Some((point, out_normal, dist)) =
+                    wall_hit(wall, x, moving.then_some(ws.offset), r)
+                else {
+                    if s.active {
+                        s.active = false;
+                        s.history = Vec3::ZERO;
+                    }
+                    s.onset = false;
+                    continue;
+                };
+                let k = b.len;
+                b.len += 1;
+                b.index[k] = q as u32;
+                let n = -out_normal;
+                let overlap = r - dist;
+                let arm = dist.max(0.0);
+                let mut wall_v = ws.velocity;
+                if belt {
+                    let s_v = wall.surface_velocity;
+                    let belt = s_v - s_v.dot(n) * n;
+                    wall_v = if moving { wall_v + belt } else { belt };
+                }
+                b.n.set(k, n);
+                b.overlap[k] = overlap;
+                b.arm[k] = arm;
+                b.v_rel.set(k, v - wall_v);
+                if rotation {
+                    b.spin.set(k, arm * w);
+                }
+                b.history.set(k, s.history);
+                if !s.active || c.shared.detail {
+                    // recorded at onset and on detail steps
+                    detail[q].point = point;
+                }
+            }
+        }
+        // ---- laws, forces
+        for k in 0..b.len {
+            let q = b.index[k] as usize;
+            b.set_law::<E>(k, &slots[q].k, &c.shared);
+        }
+        contact_forces::<E>(b, &c.shared);
+        // ---- scatter
+        for k in 0..b.len {
+            let q = b.index[k] as usize;
+            let s = &mut slots[q];
+            let onset = !s.active;
+            s.active = true;
+            s.onset = onset;
+            s.history = b.history.get(k);
+            let d = &mut detail[q];
+            if onset {
+                d.onset_normal_speed = b.v_n[k];
+                d.onset_tangential_speed = b.v_t.get(k).length();
+            }
+            let arm = b.arm[k];
+            out[q] = WallOut {
+                force: b.force.get(k),
+                torque: arm * b.torque_per_arm.get(k),
+            };
+            if c.shared.detail {
+                d.normal = b.n.get(k);
+                d.overlap = b.overlap[k];
+                d.normal_force = b.f_n[k];
+            }
+        }
+    }
+}
