@@ -47,7 +47,12 @@ fn bench_threads(c: &mut Criterion, bytes: &[u8]) {
     g.sample_size(10)
         .warm_up_time(Duration::from_secs(1))
         .measurement_time(Duration::from_secs(4));
-    for (threads, avx2) in [(1usize, true), (2, true), (1, false)] {
+    for (threads, avx2, batched) in [
+        (1usize, true, true),
+        (2, true, true),
+        (1, false, true),
+        (1, true, false),
+    ] {
         // restore the exact packed state (history included) rather than the copied initial data
         let mut sim = {
             let mut fresh = anchor_scene(45e9, TableStart::PackedIntoFunnel).expect("scene");
@@ -62,10 +67,12 @@ fn bench_threads(c: &mut Criterion, bytes: &[u8]) {
         };
         // the AVX2 build of the kernels where the CPU has it; the baseline build for comparison
         let simd = sim.set_avx2(avx2);
-        let name = if avx2 {
-            format!("threads_{threads}")
-        } else {
-            format!("threads_{threads}_baseline_no_avx2")
+        // batched contact kernels, or the one-at-a-time reference kernels for comparison
+        sim.set_batched(batched);
+        let name = match (avx2, batched) {
+            (true, true) => format!("threads_{threads}"),
+            (false, _) => format!("threads_{threads}_baseline_no_avx2"),
+            (true, false) => format!("threads_{threads}_one_contact_at_a_time"),
         };
         if avx2 && !simd {
             eprintln!("no AVX2 on this CPU: {name} runs the baseline build");

@@ -402,6 +402,8 @@ struct ParticleCtx<'a> {
     gravity: Vec3,
     dt: f64,
     wall_stride: usize,
+    /// Write the per-particle records (contact force sum, coordination numbers).
+    detail: bool,
 }
 
 /// Tangential force with Mindlin history, rotated onto the current tangent plane, and the
@@ -985,9 +987,11 @@ fn particle_chunk<const E: u16>(
             }
         }
         let (x, v, w) = (position[k], velocity[k], omega[k]);
-        force_sum[k] = f;
-        coordination[k] = z;
-        wall_coordination[k] = zw;
+        if c.detail {
+            force_sum[k] = f;
+            coordination[k] = z;
+            wall_coordination[k] = zw;
+        }
         let v_new = v + (f * inv_mass[k] + gravity) * c.dt;
         let x_new = x + v_new * c.dt;
         velocity[k] = v_new;
@@ -1374,13 +1378,18 @@ impl Simulation {
         self.needs_rebuild = false;
     }
 
+    /// Whether the next step ends with a recorded [`Frame`] (which needs the step's records).
+    fn frame_due_next(&self) -> bool {
+        self.record_every > 0 && (self.steps + 1) % self.record_every == 0
+    }
+
     /// Advance `n` steps.
     pub fn step(&mut self, n: u64) -> Result<()> {
         match self.pool.take() {
             Some(pool) if self.position.len() >= PARALLEL_MIN_PARTICLES => {
                 let r = pool.install(|| {
                     for k in 0..n {
-                        self.detail = k + 1 == n;
+                        self.detail = k + 1 == n || self.frame_due_next();
                         self.one_step(true)?;
                     }
                     Ok(())
@@ -1391,7 +1400,7 @@ impl Simulation {
             other => {
                 self.pool = other;
                 for k in 0..n {
-                    self.detail = k + 1 == n;
+                    self.detail = k + 1 == n || self.frame_due_next();
                     self.one_step(false)?;
                 }
                 Ok(())
@@ -1551,6 +1560,7 @@ impl Simulation {
                 gravity: self.gravity,
                 dt: self.dt,
                 wall_stride: stride,
+                detail: self.detail,
             };
             if parallel {
                 self.position
