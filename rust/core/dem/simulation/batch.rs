@@ -124,21 +124,34 @@ impl Batch {
         v_t: Lanes3::ZERO,
     };
 
-    /// Law values of contact `k` from its constants at its overlap.
+    /// Constants of contact `k`, copied while its record is at hand: the Hertz constants
+    /// where the AVX2 force pass evaluates the law; returns `true` where the law values are
+    /// still to be set by [`Batch::set_law`] once the overlap is known.
     #[inline(always)]
-    fn set_law<const E: u16>(&mut self, k: usize, konst: &ContactConst, c: &PairCtx<'_>) {
+    fn set_constants(&mut self, k: usize, konst: &ContactConst, c: &PairCtx<'_>) -> bool {
         let hertz = c.avx2 && konst.kind == LawKind::Hertz;
         self.hertz[k] = if hertz { u64::MAX } else { 0 };
-        let (f_el, c_n, k_t) = if hertz {
-            (konst.f_el, konst.c_n, konst.k_t)
-        } else {
-            law_at::<E>(konst, c.model, c.laws, c.effects, self.overlap[k])
-        };
-        self.f_el[k] = f_el;
-        self.c_n[k] = c_n;
-        self.k_t[k] = k_t;
+        self.f_el[k] = konst.f_el;
+        self.c_n[k] = konst.c_n;
+        self.k_t[k] = konst.k_t;
         self.ct_ratio[k] = konst.ct_ratio;
         self.mu[k] = konst.mu;
+        !hertz
+    }
+
+    /// Law values of the contacts whose law is pending (see [`Batch::set_constants`]).
+    #[inline(always)]
+    fn set_laws<const E: u16>(&mut self, c: &PairCtx<'_>, konst: impl Fn(usize) -> ContactConst) {
+        for k in 0..self.len.min(BATCH) {
+            if self.hertz[k] == 0 {
+                let kk = konst(self.index[k] as usize);
+                let (f_el, c_n, k_t) =
+                    law_at::<E>(&kk, c.model, c.laws, c.effects, self.overlap[k]);
+                self.f_el[k] = f_el;
+                self.c_n[k] = c_n;
+                self.k_t[k] = k_t;
+            }
+        }
     }
 }
 
@@ -468,6 +481,7 @@ pub(super) fn pair_chunk_batched<const E: u16>(
     while next < len {
         // ---- find the pairs in contact (and end the contacts that stopped)
         b.len = 0;
+        let mut pending = false;
         while next < len && b.len < BATCH {
             let e = next;
             next += 1;
@@ -499,11 +513,12 @@ pub(super) fn pair_chunk_batched<const E: u16>(
                 b.omega_j.set(k, c.omega[j]);
             }
             b.history.set(k, p.history);
+            pending |= b.set_constants(k, &konst[e], c);
         }
         // ---- overlaps and normals, laws, forces
         pair_geometry::<E>(b, c);
-        for k in 0..b.len {
-            b.set_law::<E>(k, &konst[b.index[k] as usize], c);
+        if pending {
+            b.set_laws::<E>(c, |e| konst[e]);
         }
         contact_forces::<E>(b, c);
         // ---- scatter
@@ -556,6 +571,7 @@ pub(super) fn wall_chunk_batched<const E: u16>(
     while next < n_slots {
         // ---- find the slots in contact, particle by particle
         b.len = 0;
+        let mut pending = false;
         while next < n_slots && b.len + stride <= BATCH {
             let first_slot = next;
             next += stride;
@@ -611,6 +627,7 @@ pub(super) fn wall_chunk_batched<const E: u16>(
                     b.spin.set(k, arm * w);
                 }
                 b.history.set(k, s.history);
+                pending |= b.set_constants(k, &s.k, &c.shared);
                 if !s.active || c.shared.detail {
                     // recorded at onset and on detail steps
                     detail[q].point = point;
@@ -618,9 +635,8 @@ pub(super) fn wall_chunk_batched<const E: u16>(
             }
         }
         // ---- laws, forces
-        for k in 0..b.len {
-            let q = b.index[k] as usize;
-            b.set_law::<E>(k, &slots[q].k, &c.shared);
+        if pending {
+            b.set_laws::<E>(&c.shared, |q| slots[q].k);
         }
         contact_forces::<E>(b, &c.shared);
         // ---- scatter
