@@ -94,6 +94,7 @@ def main() -> None:
                    help="start: square packing after --settle steps; packed: each code's packed state "
                         "made by the anchors' recipe (bench_all.py prepare; demfem's own made and cached here)")
     p.add_argument("--reps", type=int, default=1, help="repetitions; the median is reported")
+    p.add_argument("--json", default=None, help="write every run's result to this file")
     p.add_argument("--cache", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), ".states"),
                    help="where demfem's packed state is cached")
     a = p.parse_args()
@@ -108,7 +109,8 @@ def main() -> None:
         ours_state = demfem_packed_state(a.E, anchors, a.cache)
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
-        for _rep in range(a.reps):
+        for rep in range(a.reps):
+            first = len(rows)
             for t in a.threads:
                 rows.append(run_demfem(a.E, a.steps, a.settle, t, "square", ours_state if packed else None))
             if not a.skip_liggghts:
@@ -125,6 +127,10 @@ def main() -> None:
                 r = run_anchor(cmd, tmp)
                 r["code"], r["threads"] = "yade", 1
                 rows.append(r)
+            for r in rows[first:]:
+                r["rep"] = rep
+            print(f"rep {rep}: " + ", ".join(f"{r['code']} {r['threads']}: {r['particle_steps_per_s']:.3e}"
+                                            for r in rows[first:]), flush=True)
     med: dict[tuple[str, int], float] = {}
     for key in sorted({(r["code"], r["threads"]) for r in rows}):
         med[key] = statistics.median(r["particle_steps_per_s"] for r in rows if (r["code"], r["threads"]) == key)
@@ -133,11 +139,21 @@ def main() -> None:
     print(f"{'code':10s} {'threads':>7s} {'particle-steps/s':>17s}")
     for (code, t), v in med.items():
         print(f"{code:10s} {t:>7} {v:17.3e}")
+    # the machine's speed drifts between minutes: the ratio within each repetition (codes run
+    # back to back) is steadier than the ratio of the medians
+    def rate(code: str, t: int, rep: int) -> float:
+        return next(r["particle_steps_per_s"] for r in rows if (r["code"], r["threads"], r["rep"]) == (code, t, rep))
+
     for (code, t), v in med.items():
         if code != "demfem":
             for (c2, t2), ours in med.items():
                 if c2 == "demfem":
-                    print(f"demfem {t2} thread(s) / {code} {t}: {ours / v:.2f}x")
+                    per_rep = [rate("demfem", t2, k) / rate(code, t, k) for k in range(a.reps)]
+                    print(f"demfem {t2} thread(s) / {code} {t}: {ours / v:.2f}x (ratio of medians); "
+                          f"per repetition {', '.join(f'{x:.2f}' for x in per_rep)}, median {statistics.median(per_rep):.2f}x")
+    if a.json:
+        with open(a.json, "w") as f:
+            json.dump(rows, f, indent=1)
 
 
 if __name__ == "__main__":
