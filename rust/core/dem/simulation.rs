@@ -3,12 +3,20 @@
 //!
 //! One step (leapfrog, velocities stored at half steps):
 //! 1. rebuild the Verlet lists if a particle or a wall moved more than half the skin;
-//! 2. **force phase** — for every candidate pair and every particle–wall slot, in parallel
-//!    chunks (pairs and walls side by side in one `rayon::join`), the contact force from x(t)
-//!    and v(t − Δt/2) is written into the pair's or slot's own record (no shared accumulator);
-//! 3. **particle phase** — for every particle, in parallel chunks: the pair forces are gathered
-//!    in the fixed order of the particle's pair list, then its wall slots' forces in slot
-//!    order, and the particle is advanced: v += F/m Δt, x += v Δt, ω += T/I Δt.
+//! 2. **force phase** — for every candidate pair and every particle–wall slot, the contact
+//!    force from x(t) and v(t − Δt/2) is written into the pair's or slot's own record (no
+//!    shared accumulator);
+//! 3. **particle phase** — for every particle: the pair forces are gathered in the fixed order
+//!    of the particle's pair list, then its wall slots' forces in slot order, and the particle
+//!    is advanced: v += F/m Δt, x += v Δt, ω += T/I Δt.
+//!
+//! With several threads, the particles are cut into one contiguous block per thread (at
+//! rebuild, `part_cuts`); in the force phase a thread takes the pairs whose first particle is
+//! in its block and the block's wall slots, in the particle phase it advances the block. The
+//! calling thread always runs block 0, so most of what a thread writes in one phase it reads
+//! itself in the next, from its own core's cache, instead of rayon's work stealing moving
+//! the blocks between cores every step (on two threads: 1.37× the speed of the work-stealing
+//! split, median of seven alternating rounds).
 //!
 //! The kernels are monomorphised over the effect set (const generic `E`): the anchor table's
 //! set (with and without `planar`) gets a specialised step without effect tests in the inner
@@ -33,8 +41,6 @@
 //! Every floating-point sum is taken in an order fixed by the lists, never by the thread
 //! schedule, so results are bitwise identical for any thread count; the step synchronises
 //! twice. Systems below [`PARALLEL_MIN_PARTICLES`] run serially.
-
-use rayon::prelude::*;
 
 use crate::contact::{self, ForceClamp};
 use crate::dem::effects::{Effect, EffectSet};
@@ -320,6 +326,11 @@ pub struct Simulation {
     /// The pairs in which particle i is the first particle are
     /// `pairs[pair_start[i]..pair_start[i + 1]]` (the list is sorted by (i, j)).
     pub(crate) pair_start: Vec<u32>,
+    /// Where the parallel step splits its work, one (particle, pair) index per boundary
+    /// between consecutive threads' blocks: particle boundaries at multiples of
+    /// `PARTICLE_CHUNK`, pair boundaries (the first pair whose i is in the next block,
+    /// rounded) at multiples of `PAIR_CHUNK`.
+    part_cuts: Vec<(usize, usize)>,
     grid: CellGrid,
     candidate_scratch: Vec<(u32, u32)>,
     old_pairs: Vec<PairContact>,
@@ -437,6 +448,34 @@ fn tangential_force(
     }
     *history = xi;
     f_t
+}
+
+/// One thread's block of the parallel force phase (see `Simulation::part_cuts`).
+struct ForcePart<'a> {
+    pairs: &'a mut [PairContact],
+    active: &'a mut [bool],
+    out: &'a mut [PairOut],
+    detail: &'a mut [PairDetail],
+    rolling: &'a mut [Vec3],
+    /// Onsets of each of the block's pair chunks.
+    onsets: &'a mut [u32],
+    slots: &'a mut [WallContact],
+    wall_out: &'a mut [WallOut],
+    wall_detail: &'a mut [WallDetail],
+}
+
+/// `s` cut at the ascending positions `cuts` into `cuts.len() + 1` consecutive pieces.
+fn split_at_cuts<'a, T>(mut s: &'a mut [T], cuts: &[usize]) -> Vec<&'a mut [T]> {
+    let mut out = Vec::with_capacity(cuts.len() + 1);
+    let mut at = 0;
+    for &c in cuts {
+        let (head, tail) = s.split_at_mut(c - at);
+        out.push(head);
+        s = tail;
+        at = c;
+    }
+    out.push(s);
+    out
 }
 
 /// Whether the step may use its AVX2 build: the CPU has AVX2 and `DEMFEM_NO_AVX2` is unset
@@ -1122,6 +1161,7 @@ impl Simulation {
             steps: 0,
             pairs: Vec::new(),
             pair_active: Vec::new(),
+            part_cuts: Vec::new(),
             pair_out: Vec::new(),
             pair_detail: Vec::new(),
             pair_rolling: Vec::new(),
@@ -1232,6 +1272,16 @@ impl Simulation {
         for i in 0..n {
             self.pair_start[i + 1] += self.pair_start[i];
             self.csr_offset[i + 1] += self.csr_offset[i];
+        }
+        self.part_cuts.clear();
+        let parts = self.threads.max(1);
+        let mut last = (0usize, 0usize);
+        for t in 1..parts {
+            let round = |x: usize, unit: usize| (x + unit / 2) / unit * unit;
+            let p = round(n * t / parts, PARTICLE_CHUNK).clamp(last.0, n);
+            let e = round(self.pair_start[p] as usize, PAIR_CHUNK).clamp(last.1, self.pairs.len());
+            last = (p, e);
+            self.part_cuts.push(last);
         }
         self.csr_entry.clear();
         self.csr_entry.resize(self.csr_offset[n] as usize, 0);
@@ -1438,16 +1488,6 @@ impl Simulation {
     fn force_and_advance<const E: u16>(&mut self, parallel: bool) {
         let stride = self.wall_stride;
         let avx2 = self.avx2;
-        // rayon may split each parallel loop into at most about two tasks per thread: the step
-        // lasts microseconds, so fewer, larger tasks beat finer load balancing
-        let tasks = 2 * self.threads.max(1);
-        let pair_min = self.pairs.len().div_ceil(PAIR_CHUNK).div_ceil(tasks).max(1);
-        let particle_min = self
-            .position
-            .len()
-            .div_ceil(PARTICLE_CHUNK)
-            .div_ceil(tasks)
-            .max(1);
         // ---- force phase: every pair and every wall slot writes its own record only
         {
             let pair_ctx = PairCtx {
@@ -1497,34 +1537,73 @@ impl Simulation {
             let (onsets, slots) = (&mut self.chunk_onsets, &mut self.wall_slots);
             let (wall_out, wall_detail) = (&mut self.wall_out, &mut self.wall_detail);
             if parallel {
-                let slot_chunk = PARTICLE_CHUNK * stride;
-                rayon::join(
-                    || {
-                        pairs
-                            .par_chunks_mut(PAIR_CHUNK)
-                            .zip(pair_active.par_chunks_mut(PAIR_CHUNK))
-                            .zip(pair_out.par_chunks_mut(PAIR_CHUNK))
-                            .zip(pair_detail.par_chunks_mut(PAIR_CHUNK))
-                            .zip(pair_rolling.par_chunks_mut(PAIR_CHUNK))
-                            .zip(pair_const.par_chunks(PAIR_CHUNK))
-                            .with_min_len(pair_min)
-                            .map(kernel)
-                            .collect_into_vec(onsets)
-                    },
-                    || {
-                        slots
-                            .par_chunks_mut(slot_chunk)
-                            .zip(wall_out.par_chunks_mut(slot_chunk))
-                            .zip(wall_detail.par_chunks_mut(slot_chunk))
-                            .enumerate()
-                            .with_min_len(particle_min)
-                            .for_each(|(c, ((s, o), d))| {
-                                BATCH_SCRATCH.with_borrow_mut(|b| {
-                                    simd::wall::<E>(avx2, &wall_ctx, c * PARTICLE_CHUNK, s, o, d, b)
-                                })
-                            })
-                    },
-                );
+                // one part per thread: the pairs whose first particle is in a block of
+                // particles, and that block's wall slots; the particle phase then advances the
+                // same block, mostly on the same core (the calling thread always runs part 0)
+                let cut = &self.part_cuts;
+                let pair_cuts: Vec<usize> = cut.iter().map(|c| c.1).collect();
+                let chunk_cuts: Vec<usize> = pair_cuts.iter().map(|e| e / PAIR_CHUNK).collect();
+                let slot_cuts: Vec<usize> = cut.iter().map(|c| c.0 * stride).collect();
+                onsets.clear();
+                onsets.resize(pairs.len().div_ceil(PAIR_CHUNK), 0);
+                let mut parts: Vec<_> = split_at_cuts(pairs, &pair_cuts)
+                    .into_iter()
+                    .zip(split_at_cuts(pair_active, &pair_cuts))
+                    .zip(split_at_cuts(pair_out, &pair_cuts))
+                    .zip(split_at_cuts(pair_detail, &pair_cuts))
+                    .zip(split_at_cuts(pair_rolling, &pair_cuts))
+                    .zip(split_at_cuts(onsets, &chunk_cuts))
+                    .zip(split_at_cuts(slots, &slot_cuts))
+                    .zip(split_at_cuts(wall_out, &slot_cuts))
+                    .zip(split_at_cuts(wall_detail, &slot_cuts))
+                    .map(|((((((((p, a), o), d), r), on), s), wo), wd)| ForcePart {
+                        pairs: p,
+                        active: a,
+                        out: o,
+                        detail: d,
+                        rolling: r,
+                        onsets: on,
+                        slots: s,
+                        wall_out: wo,
+                        wall_detail: wd,
+                    })
+                    .enumerate()
+                    .collect();
+                let run = |(t, part): (usize, ForcePart<'_>)| {
+                    let (first_particle, first_pair) = if t == 0 { (0, 0) } else { cut[t - 1] };
+                    let ForcePart {
+                        pairs: p,
+                        active: a,
+                        out: o,
+                        detail: d,
+                        rolling: r,
+                        onsets: on,
+                        slots: s,
+                        wall_out: wo,
+                        wall_detail: wd,
+                    } = part;
+                    let konst = &pair_const[first_pair..first_pair + p.len()];
+                    let chunks = p
+                        .chunks_mut(PAIR_CHUNK)
+                        .zip(a.chunks_mut(PAIR_CHUNK))
+                        .zip(o.chunks_mut(PAIR_CHUNK))
+                        .zip(d.chunks_mut(PAIR_CHUNK))
+                        .zip(r.chunks_mut(PAIR_CHUNK))
+                        .zip(konst.chunks(PAIR_CHUNK));
+                    for (slot, chunk) in on.iter_mut().zip(chunks) {
+                        *slot = kernel(chunk);
+                    }
+                    BATCH_SCRATCH.with_borrow_mut(|b| {
+                        simd::wall::<E>(avx2, &wall_ctx, first_particle, s, wo, wd, b)
+                    });
+                };
+                let first = parts.remove(0);
+                rayon::scope(|scope| {
+                    for part in parts {
+                        scope.spawn(move |_| run(part));
+                    }
+                    run(first);
+                });
             } else {
                 onsets.clear();
                 for chunk in pairs
@@ -1563,21 +1642,50 @@ impl Simulation {
                 detail: self.detail,
             };
             if parallel {
-                self.position
-                    .par_chunks_mut(PARTICLE_CHUNK)
-                    .zip(self.velocity.par_chunks_mut(PARTICLE_CHUNK))
-                    .zip(self.omega.par_chunks_mut(PARTICLE_CHUNK))
-                    .zip(self.contact_force_sum.par_chunks_mut(PARTICLE_CHUNK))
-                    .zip(self.coordination.par_chunks_mut(PARTICLE_CHUNK))
-                    .zip(self.wall_coordination.par_chunks_mut(PARTICLE_CHUNK))
-                    .zip(self.wall_slots.par_chunks(PARTICLE_CHUNK * stride))
-                    .zip(self.wall_out.par_chunks(PARTICLE_CHUNK * stride))
+                // the blocks of the force phase (see there); one result per block
+                let cuts: Vec<usize> = self.part_cuts.iter().map(|c| c.0).collect();
+                let n_parts = cuts.len() + 1;
+                let result_cuts: Vec<usize> = (1..n_parts).collect();
+                self.chunk_results.clear();
+                self.chunk_results.resize(n_parts, (0.0, false, 0));
+                let mut parts: Vec<_> = split_at_cuts(&mut self.position, &cuts)
+                    .into_iter()
+                    .zip(split_at_cuts(&mut self.velocity, &cuts))
+                    .zip(split_at_cuts(&mut self.omega, &cuts))
+                    .zip(split_at_cuts(&mut self.contact_force_sum, &cuts))
+                    .zip(split_at_cuts(&mut self.coordination, &cuts))
+                    .zip(split_at_cuts(&mut self.wall_coordination, &cuts))
+                    .zip(split_at_cuts(&mut self.chunk_results, &result_cuts))
                     .enumerate()
-                    .with_min_len(particle_min)
-                    .map(|(c, (((((((x, v), w), f), z), zw), s), o))| {
-                        simd::particle::<E>(avx2, &ctx, c * PARTICLE_CHUNK, x, v, w, f, z, zw, s, o)
-                    })
-                    .collect_into_vec(&mut self.chunk_results);
+                    .collect();
+                let (slots, outs) = (&self.wall_slots, &self.wall_out);
+                type Part<'c> = (
+                    (
+                        (
+                            (
+                                ((&'c mut [Vec3], &'c mut [Vec3]), &'c mut [Vec3]),
+                                &'c mut [Vec3],
+                            ),
+                            &'c mut [u32],
+                        ),
+                        &'c mut [u32],
+                    ),
+                    &'c mut [(f64, bool, u32)],
+                );
+                let run = |(t, ((((((x, v), w), f), z), zw), res)): (usize, Part<'_>)| {
+                    let first = if t == 0 { 0 } else { cuts[t - 1] };
+                    let len = x.len();
+                    let slots = &slots[first * stride..(first + len) * stride];
+                    let outs = &outs[first * stride..(first + len) * stride];
+                    res[0] = simd::particle::<E>(avx2, &ctx, first, x, v, w, f, z, zw, slots, outs);
+                };
+                let first = parts.remove(0);
+                rayon::scope(|scope| {
+                    for part in parts {
+                        scope.spawn(move |_| run(part));
+                    }
+                    run(first);
+                });
             } else {
                 self.chunk_results.clear();
                 let iter = self
