@@ -57,7 +57,9 @@ use batch::{pair_chunk_batched, wall_chunk_batched, Batch, BATCH, BATCH_SCRATCH}
 /// Below this many particles the step runs on the calling thread whatever `threads` says:
 /// a rayon fork-join costs microseconds, as much as the whole step of a small system.
 pub const PARALLEL_MIN_PARTICLES: usize = 256;
+/// Pairs per kernel call (onsets are counted per chunk, to find them without a full scan).
 const PAIR_CHUNK: usize = 256;
+/// Granularity of the threads' particle blocks.
 const PARTICLE_CHUNK: usize = 64;
 const NO_WALL: u32 = u32::MAX;
 
@@ -1536,16 +1538,37 @@ impl Simulation {
             let pair_active = &mut self.pair_active;
             let (onsets, slots) = (&mut self.chunk_onsets, &mut self.wall_slots);
             let (wall_out, wall_detail) = (&mut self.wall_out, &mut self.wall_detail);
+            let cut = &self.part_cuts;
+            onsets.clear();
+            onsets.resize(pairs.len().div_ceil(PAIR_CHUNK), 0);
+            let run = |(t, part): (usize, ForcePart<'_>)| {
+                let (first_particle, first_pair) = if t == 0 { (0, 0) } else { cut[t - 1] };
+                let konst = &pair_const[first_pair..first_pair + part.pairs.len()];
+                let chunks = part
+                    .pairs
+                    .chunks_mut(PAIR_CHUNK)
+                    .zip(part.active.chunks_mut(PAIR_CHUNK))
+                    .zip(part.out.chunks_mut(PAIR_CHUNK))
+                    .zip(part.detail.chunks_mut(PAIR_CHUNK))
+                    .zip(part.rolling.chunks_mut(PAIR_CHUNK))
+                    .zip(konst.chunks(PAIR_CHUNK));
+                for (slot, chunk) in part.onsets.iter_mut().zip(chunks) {
+                    *slot = kernel(chunk);
+                }
+                BATCH_SCRATCH.with_borrow_mut(|b| {
+                    let (s, o, d) = (part.slots, part.wall_out, part.wall_detail);
+                    simd::wall::<E>(avx2, &wall_ctx, first_particle, s, o, d, b)
+                });
+            };
             if parallel {
                 // one part per thread: the pairs whose first particle is in a block of
                 // particles, and that block's wall slots; the particle phase then advances the
                 // same block, mostly on the same core (the calling thread always runs part 0)
-                let cut = &self.part_cuts;
                 let pair_cuts: Vec<usize> = cut.iter().map(|c| c.1).collect();
-                let chunk_cuts: Vec<usize> = pair_cuts.iter().map(|e| e / PAIR_CHUNK).collect();
+                // a cut is a multiple of PAIR_CHUNK or the end of the list
+                let chunk_cuts: Vec<usize> =
+                    pair_cuts.iter().map(|e| e.div_ceil(PAIR_CHUNK)).collect();
                 let slot_cuts: Vec<usize> = cut.iter().map(|c| c.0 * stride).collect();
-                onsets.clear();
-                onsets.resize(pairs.len().div_ceil(PAIR_CHUNK), 0);
                 let mut parts: Vec<_> = split_at_cuts(pairs, &pair_cuts)
                     .into_iter()
                     .zip(split_at_cuts(pair_active, &pair_cuts))
@@ -1569,34 +1592,6 @@ impl Simulation {
                     })
                     .enumerate()
                     .collect();
-                let run = |(t, part): (usize, ForcePart<'_>)| {
-                    let (first_particle, first_pair) = if t == 0 { (0, 0) } else { cut[t - 1] };
-                    let ForcePart {
-                        pairs: p,
-                        active: a,
-                        out: o,
-                        detail: d,
-                        rolling: r,
-                        onsets: on,
-                        slots: s,
-                        wall_out: wo,
-                        wall_detail: wd,
-                    } = part;
-                    let konst = &pair_const[first_pair..first_pair + p.len()];
-                    let chunks = p
-                        .chunks_mut(PAIR_CHUNK)
-                        .zip(a.chunks_mut(PAIR_CHUNK))
-                        .zip(o.chunks_mut(PAIR_CHUNK))
-                        .zip(d.chunks_mut(PAIR_CHUNK))
-                        .zip(r.chunks_mut(PAIR_CHUNK))
-                        .zip(konst.chunks(PAIR_CHUNK));
-                    for (slot, chunk) in on.iter_mut().zip(chunks) {
-                        *slot = kernel(chunk);
-                    }
-                    BATCH_SCRATCH.with_borrow_mut(|b| {
-                        simd::wall::<E>(avx2, &wall_ctx, first_particle, s, wo, wd, b)
-                    });
-                };
                 let first = parts.remove(0);
                 rayon::scope(|scope| {
                     for part in parts {
@@ -1605,20 +1600,18 @@ impl Simulation {
                     run(first);
                 });
             } else {
-                onsets.clear();
-                for chunk in pairs
-                    .chunks_mut(PAIR_CHUNK)
-                    .zip(pair_active.chunks_mut(PAIR_CHUNK))
-                    .zip(pair_out.chunks_mut(PAIR_CHUNK))
-                    .zip(pair_detail.chunks_mut(PAIR_CHUNK))
-                    .zip(pair_rolling.chunks_mut(PAIR_CHUNK))
-                    .zip(pair_const.chunks(PAIR_CHUNK))
-                {
-                    onsets.push(kernel(chunk));
-                }
-                BATCH_SCRATCH.with_borrow_mut(|b| {
-                    simd::wall::<E>(avx2, &wall_ctx, 0, slots, wall_out, wall_detail, b)
-                });
+                let whole = ForcePart {
+                    pairs,
+                    active: pair_active,
+                    out: pair_out,
+                    detail: pair_detail,
+                    rolling: pair_rolling,
+                    onsets,
+                    slots,
+                    wall_out,
+                    wall_detail,
+                };
+                run((0, whole));
             }
         }
         // ---- particle phase: gather in list order, advance
@@ -1687,33 +1680,21 @@ impl Simulation {
                     run(first);
                 });
             } else {
+                let result = simd::particle::<E>(
+                    avx2,
+                    &ctx,
+                    0,
+                    &mut self.position,
+                    &mut self.velocity,
+                    &mut self.omega,
+                    &mut self.contact_force_sum,
+                    &mut self.coordination,
+                    &mut self.wall_coordination,
+                    &self.wall_slots,
+                    &self.wall_out,
+                );
                 self.chunk_results.clear();
-                let iter = self
-                    .position
-                    .chunks_mut(PARTICLE_CHUNK)
-                    .zip(self.velocity.chunks_mut(PARTICLE_CHUNK))
-                    .zip(self.omega.chunks_mut(PARTICLE_CHUNK))
-                    .zip(self.contact_force_sum.chunks_mut(PARTICLE_CHUNK))
-                    .zip(self.coordination.chunks_mut(PARTICLE_CHUNK))
-                    .zip(self.wall_coordination.chunks_mut(PARTICLE_CHUNK))
-                    .zip(self.wall_slots.chunks(PARTICLE_CHUNK * stride))
-                    .zip(self.wall_out.chunks(PARTICLE_CHUNK * stride))
-                    .enumerate();
-                for (c, (((((((x, v), w), f), z), zw), s), o)) in iter {
-                    self.chunk_results.push(simd::particle::<E>(
-                        avx2,
-                        &ctx,
-                        c * PARTICLE_CHUNK,
-                        x,
-                        v,
-                        w,
-                        f,
-                        z,
-                        zw,
-                        s,
-                        o,
-                    ));
-                }
+                self.chunk_results.push(result);
             }
         }
     }
