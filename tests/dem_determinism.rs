@@ -84,6 +84,11 @@ fn one_and_two_threads_are_bitwise_identical() {
     assert_eq!(bits(&a), bits(&b));
     assert_eq!(a.onsets(), b.onsets());
     assert_eq!(a.onsets().is_empty(), false);
+    // three blocks of particles (more threads than cores is allowed) cut the lists elsewhere
+    let mut c = packed_soft(3);
+    c.step(3000).unwrap();
+    assert!(bits(&a) == bits(&c), "3 threads differ from 1");
+    assert_eq!(a.onsets(), c.onsets());
 }
 
 #[test]
