@@ -552,6 +552,88 @@ fn law_at<const E: u16>(
     }
 }
 
+/// The centre distance x_j − x_i and its square when pair `p` touches; otherwise ends a
+/// contact that was active (flags, history, the gather's overlap) and returns `None`.
+/// Shared by [`pair_kernel`] and the batched kernel.
+#[inline(always)]
+fn pair_in_reach(
+    p: &mut PairContact,
+    active: &mut bool,
+    out: &mut PairOut,
+    position: &[Vec3],
+) -> Option<(Vec3, f64)> {
+    let d = position[p.j as usize] - position[p.i as usize];
+    let dist2 = d.length_squared();
+    let r_sum = p.r_sum;
+    if dist2 >= r_sum * r_sum || dist2 == 0.0 {
+        // an inactive pair has nothing to reset: its output slot already reads "no contact"
+        // (onset is only ever set together with active)
+        if *active {
+            *active = false;
+            p.onset = false;
+            p.history = Vec3::ZERO;
+            out.overlap = 0.0;
+        }
+        return None;
+    }
+    Some((d, dist2))
+}
+
+/// Where and how a particle of radius `r` at `x` touches the wall of slot `s`.
+struct WallTouch {
+    /// Contact point on the wall, m.
+    point: Vec3,
+    /// Unit normal from the particle towards the wall.
+    n: Vec3,
+    /// Overlap, m.
+    overlap: f64,
+    /// Lever arm of the particle, m.
+    arm: f64,
+    /// Velocity of the wall's material at the contact (motion plus belt), m/s.
+    wall_v: Vec3,
+}
+
+/// The contact of slot `s` when the particle touches its wall; otherwise ends a contact that
+/// was active and returns `None`. Shared by [`wall_kernel`] and the batched kernel.
+#[inline(always)]
+fn wall_touch<const E: u16>(
+    s: &mut WallContact,
+    x: Vec3,
+    r: f64,
+    c: &WallCtx<'_>,
+) -> Option<WallTouch> {
+    let wall = &c.walls[s.wall as usize];
+    // fixed walls (no moving_walls effect) sit at offset 0 with velocity 0: skip both
+    let moving = on::<E>(c.shared.effects, Effect::MovingWalls);
+    let ws = if moving {
+        c.wall_state[s.wall as usize]
+    } else {
+        WallState::default()
+    };
+    let Some((point, out_normal, dist)) = wall_hit(wall, x, moving.then_some(ws.offset), r) else {
+        if s.active {
+            s.active = false;
+            s.history = Vec3::ZERO;
+        }
+        s.onset = false;
+        return None;
+    };
+    let n = -out_normal; // from the particle towards the wall
+    let mut wall_v = ws.velocity;
+    if on::<E>(c.shared.effects, Effect::Belt) {
+        let s_v = wall.surface_velocity;
+        let belt = s_v - s_v.dot(n) * n;
+        wall_v = if moving { wall_v + belt } else { belt };
+    }
+    Some(WallTouch {
+        point,
+        n,
+        overlap: r - dist,
+        arm: dist.max(0.0),
+        wall_v,
+    })
+}
+
 /// Force of one candidate pair; returns whether a contact began.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
@@ -564,22 +646,11 @@ fn pair_kernel<const E: u16>(
     rolling_torque: &mut Vec3,
     c: &PairCtx<'_>,
 ) -> bool {
-    let i = p.i as usize;
-    let j = p.j as usize;
-    let d = c.position[j] - c.position[i];
-    let dist2 = d.length_squared();
-    let r_sum = p.r_sum;
-    if dist2 >= r_sum * r_sum || dist2 == 0.0 {
-        // an inactive pair has nothing to reset: its output slot already reads "no contact"
-        // (onset is only ever set together with active)
-        if *active {
-            *active = false;
-            p.onset = false;
-            p.history = Vec3::ZERO;
-            out.overlap = 0.0;
-        }
+    let Some((d, dist2)) = pair_in_reach(p, active, out, c.position) else {
         return false;
-    }
+    };
+    let (i, j) = (p.i as usize, p.j as usize);
+    let r_sum = p.r_sum;
     let dist = dist2.sqrt();
     // rounding can give dist = r_sum for dist² just below r_sum²; keep the overlap positive,
     // the gather's activity test
@@ -785,36 +856,18 @@ fn wall_kernel<const E: u16>(
     w: Vec3,
     c: &WallCtx<'_>,
 ) {
-    let wall = &c.walls[s.wall as usize];
-    // fixed walls (no moving_walls effect) sit at offset 0 with velocity 0: skip both
-    let moving = on::<E>(c.shared.effects, Effect::MovingWalls);
-    let ws = if moving {
-        c.wall_state[s.wall as usize]
-    } else {
-        WallState::default()
-    };
     let r = c.shared.radius[i];
-    let (point, out_normal, dist) = match wall_hit(wall, x, moving.then_some(ws.offset), r) {
-        Some(h) => h,
-        None => {
-            if s.active {
-                s.active = false;
-                s.history = Vec3::ZERO;
-            }
-            s.onset = false;
-            return;
-        }
+    let Some(WallTouch {
+        point,
+        n,
+        overlap,
+        arm,
+        wall_v,
+    }) = wall_touch::<E>(s, x, r, c)
+    else {
+        return;
     };
-    let n = -out_normal; // from the particle towards the wall
-    let overlap = r - dist;
     let rotation = on::<E>(c.shared.effects, Effect::Rotation);
-    let arm = dist.max(0.0);
-    let mut wall_v = ws.velocity;
-    if on::<E>(c.shared.effects, Effect::Belt) {
-        let s_v = wall.surface_velocity;
-        let belt = s_v - s_v.dot(n) * n;
-        wall_v = if moving { wall_v + belt } else { belt };
-    }
     let mut v_rel = v - wall_v;
     if rotation {
         v_rel += (arm * w).cross(n);

@@ -185,7 +185,7 @@ fn pair_geometry<const E: u16>(b: &mut Batch, c: &PairCtx<'_>) {
 
 /// Force pass of a batch: normal force with damping and clamp, Mindlin tangential force with
 /// the Coulomb cap, n × f_t; the operations of [`pair_kernel`] and [`wall_kernel`] in their
-/// order. Branch-free apart from effect tests that are constant over the batch.
+/// order (the scalar loop here, the AVX2 build in `avx2_forces` with selects for branches).
 #[inline(always)]
 fn contact_forces<const E: u16>(b: &mut Batch, c: &PairCtx<'_>) {
     #[cfg(target_arch = "x86_64")]
@@ -206,26 +206,24 @@ fn contact_forces<const E: u16>(b: &mut Batch, c: &PairCtx<'_>) {
         let v_n = v_rel.dot(n);
         let v_t = v_rel - v_n * n;
         let c_n = b.c_n[k];
-        let f_n = b.f_el[k] + c_n * v_n;
-        let f_n = if clamp && f_n < 0.0 { 0.0 } else { f_n };
+        let mut f_n = b.f_el[k] + c_n * v_n;
+        if clamp && f_n < 0.0 {
+            f_n = 0.0;
+        }
         let mut force = -f_n * n;
         let mut torque_per_arm = Vec3::ZERO;
         if friction {
-            // `tangential_force` with its branches turned into selects
-            let k_t = b.k_t[k];
-            let c_t = c_n * b.ct_ratio[k];
-            let cap = b.mu[k] * f_n.max(0.0);
             let mut xi = b.history.get(k);
-            xi -= xi.dot(n) * n;
-            xi += v_t * dt;
-            let f_stick = -k_t * xi - c_t * v_t;
-            let f2 = f_stick.length_squared();
-            let sliding = f2 > cap * cap;
-            let f_slide = f_stick * (cap / f2.sqrt());
-            let inv = -1.0 / k_t;
-            let xi_slide = if k_t > 0.0 { f_slide * inv } else { Vec3::ZERO };
-            let f_t = select3(sliding, f_slide, f_stick);
-            b.history.set(k, select3(sliding, xi_slide, xi));
+            let f_t = tangential_force(
+                &mut xi,
+                n,
+                v_t,
+                b.k_t[k],
+                c_n * b.ct_ratio[k],
+                b.mu[k] * f_n.max(0.0),
+                dt,
+            );
+            b.history.set(k, xi);
             force += f_t;
             if rotation {
                 torque_per_arm = n.cross(f_t);
@@ -446,16 +444,6 @@ mod avx2_forces {
     }
 }
 
-/// `if m { a } else { b }` per component, written so that it compiles to a blend.
-#[inline(always)]
-fn select3(m: bool, a: Vec3, b: Vec3) -> Vec3 {
-    Vec3::new(
-        if m { a.x } else { b.x },
-        if m { a.y } else { b.y },
-        if m { a.z } else { b.z },
-    )
-}
-
 /// The pairs of one chunk in batches (see [`Batch`]); returns the number of onsets.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
@@ -486,19 +474,11 @@ pub(super) fn pair_chunk_batched<const E: u16>(
             let e = next;
             next += 1;
             let p = &mut chunk[e];
-            let (i, j) = (p.i as usize, p.j as usize);
-            let d = c.position[j] - c.position[i];
-            let dist2 = d.length_squared();
-            let r_sum = p.r_sum;
-            if dist2 >= r_sum * r_sum || dist2 == 0.0 {
-                if active[e] {
-                    active[e] = false;
-                    p.onset = false;
-                    p.history = Vec3::ZERO;
-                    out[e].overlap = 0.0;
-                }
+            let Some((d, dist2)) = pair_in_reach(p, &mut active[e], &mut out[e], c.position) else {
                 continue;
-            }
+            };
+            let (i, j) = (p.i as usize, p.j as usize);
+            let r_sum = p.r_sum;
             let k = b.len;
             b.len += 1;
             b.index[k] = e as u32;
@@ -560,9 +540,7 @@ pub(super) fn wall_chunk_batched<const E: u16>(
     detail: &mut [WallDetail],
     b: &mut Batch,
 ) {
-    let moving = on::<E>(c.shared.effects, Effect::MovingWalls);
     let rotation = on::<E>(c.shared.effects, Effect::Rotation);
-    let belt = on::<E>(c.shared.effects, Effect::Belt);
     let stride = c.wall_stride;
     let n_slots = slots.len();
     let (out, detail) = (&mut out[..n_slots], &mut detail[..n_slots]);
@@ -591,34 +569,19 @@ pub(super) fn wall_chunk_batched<const E: u16>(
                 if s.wall == NO_WALL {
                     break;
                 }
-                let wall = &c.walls[s.wall as usize];
-                let ws = if moving {
-                    c.wall_state[s.wall as usize]
-                } else {
-                    WallState::default()
-                };
-                let Some((point, out_normal, dist)) =
-                    wall_hit(wall, x, moving.then_some(ws.offset), r)
+                let Some(WallTouch {
+                    point,
+                    n,
+                    overlap,
+                    arm,
+                    wall_v,
+                }) = wall_touch::<E>(s, x, r, c)
                 else {
-                    if s.active {
-                        s.active = false;
-                        s.history = Vec3::ZERO;
-                    }
-                    s.onset = false;
                     continue;
                 };
                 let k = b.len;
                 b.len += 1;
                 b.index[k] = q as u32;
-                let n = -out_normal;
-                let overlap = r - dist;
-                let arm = dist.max(0.0);
-                let mut wall_v = ws.velocity;
-                if belt {
-                    let s_v = wall.surface_velocity;
-                    let belt = s_v - s_v.dot(n) * n;
-                    wall_v = if moving { wall_v + belt } else { belt };
-                }
                 b.n.set(k, n);
                 b.overlap[k] = overlap;
                 b.arm[k] = arm;
