@@ -56,7 +56,7 @@ def main() -> None:
         alone.append(r1)
         tax.append(tp / t1)
         threads2.append(r2)
-        ceiling.append(2 * r1 / (tp / t1))
+        ceiling.append(2 * r1 / tax[-1])
         eff.append(r2 / ceiling[-1])
     med = statistics.median
     print(f"1 thread alone: {med(alone):.3e} particle-steps/s (by round: "
