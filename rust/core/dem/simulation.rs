@@ -31,7 +31,9 @@
 //! gathered first, then their geometry, laws and forces are computed in short loops (four
 //! contacts per instruction with AVX2), then scattered. One contact at a time, its chain of
 //! dependent operations (δ → √δ → δ^{1/4} → f_n → Coulomb cap → scaling) kept the processor
-//! waiting; in a batch the chains of many contacts overlap. The one-at-a-time kernels
+//! waiting; in a batch the chains of many contacts overlap. With AVX2, plane-wall slots (the
+//! belt under every sphere) go into the batch four particles at a time, read as lanes rather
+//! than copied contact by contact (`batch::plane_slots`). The one-at-a-time kernels
 //! (`pair_kernel`, `wall_kernel`) remain the reference, used with rolling resistance, and
 //! the batches reproduce them bit for bit ([`Simulation::set_batched`]).
 //!
@@ -112,6 +114,7 @@ pub(crate) struct PairDetail {
 ///   ζ √(2/3 m* dF/dδ) (see [`contact::HertzReissnerScaled`]);
 /// - [`LawKind::Linear`]: F_el = `f_el` δ, k_t = `k_t`, c_n = `c_n`.
 #[derive(Debug, Clone, Copy, Default)]
+#[repr(C)]
 pub(crate) struct ContactConst {
     r_star: f64,
     /// (k_H/k_R)², 1/m, for [`LawKind::HertzReissner`] (else 0): s = `s_scale` δ.
@@ -211,6 +214,9 @@ pub(crate) struct WallContact {
     pub(crate) wall: u32,
     pub(crate) active: bool,
     pub(crate) onset: bool,
+    /// The AVX2 plane pass evaluated this slot in the current step (`batch::plane_slots`), so
+    /// the batched wall kernel skips it. Transient: rewritten every AVX2 step, not saved.
+    pub(crate) planar_pass: bool,
     pub(crate) history: Vec3,
     /// Law constants of this particle against this wall (derived, not checkpointed).
     pub(crate) k: ContactConst,
@@ -222,6 +228,7 @@ impl Default for WallContact {
             wall: NO_WALL,
             active: false,
             onset: false,
+            planar_pass: false,
             history: Vec3::ZERO,
             k: ContactConst::default(),
         }
@@ -230,6 +237,7 @@ impl Default for WallContact {
 
 /// Force (N) and torque (N·m) of an active wall slot on its particle, read by the gather.
 #[derive(Debug, Clone, Copy, Default)]
+#[repr(C)]
 pub(crate) struct WallOut {
     force: Vec3,
     torque: Vec3,
@@ -1031,6 +1039,14 @@ fn particle_chunk<const E: u16>(
     let (velocity, omega) = (&mut velocity[..len], &mut omega[..len]);
     let (force_sum, coordination) = (&mut force_sum[..len], &mut coordination[..len]);
     let wall_coordination = &mut wall_coordination[..len];
+    // the pair arrays cut to one length, so one bounds check covers the three
+    let n_pairs = c.pair_out.len();
+    let (pair_active, pair_out) = (&c.pair_active[..n_pairs], &c.pair_out[..n_pairs]);
+    let pair_rolling = if rolling {
+        &c.pair_rolling[..n_pairs]
+    } else {
+        &[]
+    };
     let stride = c.wall_stride;
     for (k, (slots, outs)) in slots
         .chunks_exact(stride)
@@ -1047,33 +1063,38 @@ fn particle_chunk<const E: u16>(
         // pairs in increasing index order: first those where the particle is j (their i is
         // smaller, so their indices come first), listed in the CSR ...
         for &e in &c.csr_entry[offset[k] as usize..offset[k + 1] as usize] {
-            if !c.pair_active[e as usize] {
+            let e = e as usize;
+            let Some(true) = pair_active.get(e) else {
                 continue;
-            }
-            let p = &c.pair_out[e as usize];
+            };
+            let p = &pair_out[e];
             z += 1;
             f -= p.force;
             if rotation {
                 let arm = radius[k] - 0.5 * p.overlap;
                 t += arm * p.torque_per_arm;
                 if rolling {
-                    t -= c.pair_rolling[e as usize];
+                    t -= pair_rolling[e];
                 }
             }
         }
         // ... then those where it is i: a contiguous range of the sorted pair list
-        for e in pair_start[k] as usize..pair_start[k + 1] as usize {
-            if !c.pair_active[e] {
+        let own = pair_start[k] as usize..pair_start[k + 1] as usize;
+        for (e, (&on, p)) in pair_active[own.clone()]
+            .iter()
+            .zip(&pair_out[own.clone()])
+            .enumerate()
+        {
+            if !on {
                 continue;
             }
-            let p = &c.pair_out[e];
             z += 1;
             f += p.force;
             if rotation {
                 let arm = radius[k] - 0.5 * p.overlap;
                 t += arm * p.torque_per_arm;
                 if rolling {
-                    t += c.pair_rolling[e];
+                    t += pair_rolling[own.start + e];
                 }
             }
         }
@@ -1937,6 +1958,24 @@ impl Simulation {
     /// rolling resistance always run one at a time.
     pub fn set_batched(&mut self, on: bool) {
         self.batched = on;
+    }
+
+    /// How many particle–wall slots the AVX2 plane pass took in the last step (four particles
+    /// at a time; see the module doc): a diagnostic of the kernels, 0 when the step does not
+    /// use it (no AVX2, no batches, rolling resistance).
+    pub fn plane_pass_slots(&self) -> usize {
+        let used = self.avx2
+            && self.batched
+            && !self.effects.has(Effect::RollingResistance)
+            && self.wall_stride <= BATCH
+            && self.steps > 0;
+        if !used {
+            return 0;
+        }
+        self.wall_slots
+            .iter()
+            .filter(|s| s.wall != NO_WALL && s.planar_pass)
+            .count()
     }
 
     /// Whether contacts are evaluated in batches (see [`Simulation::set_batched`]).

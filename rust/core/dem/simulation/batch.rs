@@ -335,6 +335,319 @@ mod avx2_forces {
         }
     }
 
+    /// Four consecutive vectors from `p` (12 f64) as lanes: three loads, six shuffles.
+    #[inline(always)]
+    unsafe fn load_aos4(p: *const Vec3) -> V4 {
+        let f = p as *const f64;
+        // a = x0 y0 z0 x1, b = y1 z1 x2 y2, c = z2 x3 y3 z3
+        let (a, b, c) = (
+            _mm256_loadu_pd(f),
+            _mm256_loadu_pd(f.add(4)),
+            _mm256_loadu_pd(f.add(8)),
+        );
+        let m1 = _mm256_blend_pd::<0b1100>(a, b); // x0 y0 x2 y2
+        let m2 = _mm256_permute2f128_pd::<0x21>(a, c); // z0 x1 z2 x3
+        let m3 = _mm256_blend_pd::<0b1100>(b, c); // y1 z1 y3 z3
+        V4 {
+            x: _mm256_shuffle_pd::<0b1010>(m1, m2),
+            y: _mm256_shuffle_pd::<0b0101>(m1, m3),
+            z: _mm256_shuffle_pd::<0b1010>(m2, m3),
+        }
+    }
+
+    /// 4×4 transpose: lane l of row k becomes lane k of row l.
+    #[inline(always)]
+    unsafe fn transpose(a: __m256d, b: __m256d, c: __m256d, d: __m256d) -> [__m256d; 4] {
+        let t0 = _mm256_unpacklo_pd(a, b);
+        let t1 = _mm256_unpackhi_pd(a, b);
+        let t2 = _mm256_unpacklo_pd(c, d);
+        let t3 = _mm256_unpackhi_pd(c, d);
+        [
+            _mm256_permute2f128_pd::<0x20>(t0, t2),
+            _mm256_permute2f128_pd::<0x20>(t1, t3),
+            _mm256_permute2f128_pd::<0x31>(t0, t2),
+            _mm256_permute2f128_pd::<0x31>(t1, t3),
+        ]
+    }
+
+    /// A plane wall's constants broadcast to four lanes.
+    struct PlaneLanes {
+        point: V4,
+        normal: V4,
+        /// Wall offset (moving walls), m.
+        offset: V4,
+        /// Contact normal, −normal.
+        n: V4,
+        /// Velocity of the wall's material at a contact (`wall_touch`), m/s.
+        wall_v: V4,
+    }
+
+    /// The lanes of wall `w` if it is a plane (`wall_touch`'s operations: its wall velocity
+    /// is the same over the whole plane).
+    #[inline(always)]
+    unsafe fn plane_lanes<const E: u16>(c: &WallCtx<'_>, w: u32) -> Option<PlaneLanes> {
+        let wall = c.walls.get(w as usize)?;
+        let WallShape::Plane { point, normal } = wall.shape else {
+            return None;
+        };
+        let moving = on::<E>(c.shared.effects, Effect::MovingWalls);
+        let ws = if moving {
+            c.wall_state[w as usize]
+        } else {
+            WallState::default()
+        };
+        let n = -normal;
+        let mut wall_v = ws.velocity;
+        if on::<E>(c.shared.effects, Effect::Belt) {
+            let s_v = wall.surface_velocity;
+            let belt = s_v - s_v.dot(n) * n;
+            wall_v = if moving { wall_v + belt } else { belt };
+        }
+        let bc = |v: Vec3| V4 {
+            x: _mm256_set1_pd(v.x),
+            y: _mm256_set1_pd(v.y),
+            z: _mm256_set1_pd(v.z),
+        };
+        Some(PlaneLanes {
+            point: bc(point),
+            normal: bc(normal),
+            offset: bc(ws.offset),
+            n: bc(n),
+            wall_v: bc(wall_v),
+        })
+    }
+
+    /// The plane-wall slots of a chunk of particles, four particles at a time: for each
+    /// group of four consecutive alive particles and slot column whose four slots hold the
+    /// same plane with Hertz constants, the particles' state is loaded as lanes (no
+    /// per-contact copies), the plane test, overlap, lever arm and relative velocity are
+    /// computed four at a time into the batch, and the batch goes through
+    /// [`contact_forces`]; the results are scattered as by [`wall_chunk_batched`]. Every
+    /// lane runs the operations of `wall_touch` and `wall_kernel` in their order, so the
+    /// results are bitwise theirs. Marks each slot it took (`planar_pass`), so the batched
+    /// kernel skips it.
+    #[target_feature(enable = "avx2")]
+    pub(super) unsafe fn plane_slots<const E: u16>(
+        c: &WallCtx<'_>,
+        first: usize,
+        slots: &mut [WallContact],
+        out: &mut [WallOut],
+        detail: &mut [WallDetail],
+        b: &mut Batch,
+    ) {
+        let stride = c.wall_stride;
+        let n_slots = slots.len();
+        let n_part = n_slots / stride;
+        let (out, detail) = (&mut out[..n_slots], &mut detail[..n_slots]);
+        let moving = on::<E>(c.shared.effects, Effect::MovingWalls);
+        let rotation = on::<E>(c.shared.effects, Effect::Rotation);
+        let position = &c.shared.position[first..first + n_part];
+        let velocity = &c.shared.velocity[first..first + n_part];
+        let omega = &c.shared.omega[first..first + n_part];
+        let radius = &c.shared.radius[first..first + n_part];
+        let alive = &c.alive[first..first + n_part];
+        let zero = _mm256_setzero_pd();
+        let all = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
+        let mask3 = _mm256_setr_epi64x(-1, -1, -1, 0);
+        // groups in the batch: first particle (in the chunk), column, reach mask
+        let mut groups = [(0u32, 0u32, 0u32); BATCH / 4];
+        let mut n_groups = 0usize;
+        // the lanes of the last wall seen (slot columns mostly hold the same wall)
+        let mut plane: (u32, Option<PlaneLanes>) = (NO_WALL, None);
+        b.len = 0;
+        let groups_end = n_part / 4 * 4;
+        let mut g = 0;
+        while g < groups_end {
+            for q in 0..stride {
+                let s0 = g * stride + q;
+                let w = slots[s0].wall;
+                if (0..4).all(|l| slots[s0 + l * stride].wall == NO_WALL) {
+                    // the four particles' lists end here
+                    break;
+                }
+                if w != plane.0 {
+                    plane = (w, plane_lanes::<E>(c, w));
+                }
+                let take = plane.1.is_some()
+                    && (0..4).all(|l| {
+                        let s = &slots[s0 + l * stride];
+                        s.wall == w && alive[g + l] && s.k.kind == LawKind::Hertz
+                    });
+                for l in 0..4 {
+                    slots[s0 + l * stride].planar_pass = take;
+                }
+                let Some(pl) = plane.1.as_ref().filter(|_| take) else {
+                    continue;
+                };
+                // `wall_hit`: d = normal · (x − offset − point), in reach when d < r
+                let mut x = load_aos4(position.as_ptr().add(g));
+                if moving {
+                    x = sub(x, pl.offset);
+                }
+                let d = dot(pl.normal, sub(x, pl.point));
+                let r = _mm256_loadu_pd(radius.as_ptr().add(g));
+                let reach = _mm256_cmp_pd::<_CMP_LT_OQ>(d, r);
+                let m = _mm256_movemask_pd(reach) as u32;
+                if m != 0b1111 {
+                    // out of reach: `wall_touch`'s reset
+                    for l in 0..4 {
+                        if m >> l & 1 == 0 {
+                            let s = &mut slots[s0 + l * stride];
+                            if s.active {
+                                s.active = false;
+                                s.history = Vec3::ZERO;
+                            }
+                            s.onset = false;
+                        }
+                    }
+                    if m == 0 {
+                        continue;
+                    }
+                }
+                let k = 4 * n_groups;
+                let overlap = _mm256_sub_pd(r, d);
+                let arm = _mm256_max_pd(d, zero);
+                store(&mut b.n, k, pl.n);
+                st(&mut b.overlap, k, overlap);
+                st(&mut b.arm, k, arm);
+                store(
+                    &mut b.v_rel,
+                    k,
+                    sub(load_aos4(velocity.as_ptr().add(g)), pl.wall_v),
+                );
+                if rotation {
+                    store(&mut b.spin, k, scale(arm, load_aos4(omega.as_ptr().add(g))));
+                }
+                let sp = |l: usize| &slots[s0 + l * stride];
+                let hrow = |l: usize| _mm256_maskload_pd(&sp(l).history.x, mask3);
+                let [hx, hy, hz, _] = transpose(hrow(0), hrow(1), hrow(2), hrow(3));
+                store(
+                    &mut b.history,
+                    k,
+                    V4 {
+                        x: hx,
+                        y: hy,
+                        z: hz,
+                    },
+                );
+                // f_el, k_t, c_n, c_t/c_n are 32 contiguous bytes of a `ContactConst`
+                let krow = |l: usize| _mm256_loadu_pd(&sp(l).k.f_el);
+                let [f_el, k_t, c_n, ct_ratio] = transpose(krow(0), krow(1), krow(2), krow(3));
+                st(&mut b.f_el, k, f_el);
+                st(&mut b.k_t, k, k_t);
+                st(&mut b.c_n, k, c_n);
+                st(&mut b.ct_ratio, k, ct_ratio);
+                st(
+                    &mut b.mu,
+                    k,
+                    _mm256_setr_pd(sp(0).k.mu, sp(1).k.mu, sp(2).k.mu, sp(3).k.mu),
+                );
+                _mm256_storeu_si256(
+                    b.hertz.as_mut_ptr().add(k) as *mut __m256i,
+                    _mm256_castpd_si256(all),
+                );
+                groups[n_groups] = (g as u32, q as u32, m);
+                n_groups += 1;
+                b.len = 4 * n_groups;
+                if n_groups == BATCH / 4 {
+                    plane_scatter::<E>(c, first, &groups[..n_groups], slots, out, detail, b);
+                    n_groups = 0;
+                    b.len = 0;
+                }
+            }
+            g += 4;
+        }
+        if n_groups > 0 {
+            plane_scatter::<E>(c, first, &groups[..n_groups], slots, out, detail, b);
+        }
+        b.len = 0;
+        for s in &mut slots[groups_end * stride..] {
+            s.planar_pass = false;
+        }
+    }
+
+    /// Forces of the groups of [`plane_slots`] in the batch, and their scatter (that of
+    /// [`wall_chunk_batched`]).
+    #[inline(always)]
+    unsafe fn plane_scatter<const E: u16>(
+        c: &WallCtx<'_>,
+        first: usize,
+        groups: &[(u32, u32, u32)],
+        slots: &mut [WallContact],
+        out: &mut [WallOut],
+        detail: &mut [WallDetail],
+        b: &mut Batch,
+    ) {
+        contact_forces::<E>(b, &c.shared);
+        let stride = c.wall_stride;
+        let moving = on::<E>(c.shared.effects, Effect::MovingWalls);
+        for (gi, &(g, q, m)) in groups.iter().enumerate() {
+            let full = m == 0b1111;
+            if full {
+                // the four outputs as rows: force and torque, 6 f64 each
+                let k = 4 * gi;
+                let f = load(&b.force, k);
+                let t = scale(ld(&b.arm, k), load(&b.torque_per_arm, k));
+                let lo = transpose(f.x, f.y, f.z, t.x);
+                let yz_02 = _mm256_unpacklo_pd(t.y, t.z); // ty0 tz0 ty2 tz2
+                let yz_13 = _mm256_unpackhi_pd(t.y, t.z); // ty1 tz1 ty3 tz3
+                let hi = [
+                    _mm256_castpd256_pd128(yz_02),
+                    _mm256_castpd256_pd128(yz_13),
+                    _mm256_extractf128_pd::<1>(yz_02),
+                    _mm256_extractf128_pd::<1>(yz_13),
+                ];
+                for l in 0..4 {
+                    let dst =
+                        out.as_mut_ptr().add((g as usize + l) * stride + q as usize) as *mut f64;
+                    _mm256_storeu_pd(dst, lo[l]);
+                    _mm_storeu_pd(dst.add(4), hi[l]);
+                }
+            }
+            for l in 0..4 {
+                if m >> l & 1 == 0 {
+                    continue;
+                }
+                let k = 4 * gi + l;
+                let i = g as usize + l;
+                let slot = i * stride + q as usize;
+                let s = &mut slots[slot];
+                let onset = !s.active;
+                let d = &mut detail[slot];
+                if onset || c.shared.detail {
+                    // recorded at onset and on detail steps
+                    let wall = &c.walls[s.wall as usize];
+                    let offset = moving.then(|| c.wall_state[s.wall as usize].offset);
+                    let x = c.shared.position[first + i];
+                    if let Some((point, _, _)) =
+                        wall_hit(wall, x, offset, c.shared.radius[first + i])
+                    {
+                        d.point = point;
+                    }
+                }
+                s.active = true;
+                s.onset = onset;
+                s.history = b.history.get(k);
+                if onset {
+                    d.onset_normal_speed = b.v_n[k];
+                    d.onset_tangential_speed = b.v_t.get(k).length();
+                }
+                if !full {
+                    let arm = b.arm[k];
+                    out[slot] = WallOut {
+                        force: b.force.get(k),
+                        torque: arm * b.torque_per_arm.get(k),
+                    };
+                }
+                if c.shared.detail {
+                    d.normal = b.n.get(k);
+                    d.overlap = b.overlap[k];
+                    d.normal_force = b.f_n[k];
+                }
+            }
+        }
+    }
+
     #[target_feature(enable = "avx2")]
     pub(super) unsafe fn pair_geometry<const E: u16>(b: &mut Batch, c: &PairCtx<'_>) {
         let rotation = on::<E>(c.effects, Effect::Rotation);
@@ -444,6 +757,16 @@ mod avx2_forces {
     }
 }
 
+// The layouts `plane_slots` reads and writes whole rows of.
+const _: () = {
+    use std::mem::{offset_of, size_of};
+    assert!(size_of::<Vec3>() == 24 && offset_of!(Vec3, y) == 8 && offset_of!(Vec3, z) == 16);
+    assert!(offset_of!(ContactConst, k_t) == offset_of!(ContactConst, f_el) + 8);
+    assert!(offset_of!(ContactConst, c_n) == offset_of!(ContactConst, f_el) + 16);
+    assert!(offset_of!(ContactConst, ct_ratio) == offset_of!(ContactConst, f_el) + 24);
+    assert!(size_of::<WallOut>() == 48 && offset_of!(WallOut, torque) == 24);
+};
+
 /// The pairs of one chunk in batches (see [`Batch`]); returns the number of onsets.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
@@ -543,6 +866,13 @@ pub(super) fn wall_chunk_batched<const E: u16>(
     let rotation = on::<E>(c.shared.effects, Effect::Rotation);
     let stride = c.wall_stride;
     let n_slots = slots.len();
+    // with AVX2, plane slots four particles at a time first; they are skipped below
+    let planar = c.shared.avx2;
+    #[cfg(target_arch = "x86_64")]
+    if planar {
+        // SAFETY: `avx2` is set only when the CPU reported AVX2.
+        unsafe { avx2_forces::plane_slots::<E>(c, first, slots, out, detail, b) };
+    }
     let (out, detail) = (&mut out[..n_slots], &mut detail[..n_slots]);
     let mut next = 0usize;
     let mut particle = first;
@@ -558,6 +888,15 @@ pub(super) fn wall_chunk_batched<const E: u16>(
             if !c.alive[i] {
                 continue;
             }
+            let own = &slots[first_slot..first_slot + stride];
+            if planar
+                && own
+                    .iter()
+                    .take_while(|s| s.wall != NO_WALL)
+                    .all(|s| s.planar_pass)
+            {
+                continue;
+            }
             let (x, v, w) = (
                 c.shared.position[i],
                 c.shared.velocity[i],
@@ -568,6 +907,9 @@ pub(super) fn wall_chunk_batched<const E: u16>(
                 let s = &mut slots[q];
                 if s.wall == NO_WALL {
                     break;
+                }
+                if planar && s.planar_pass {
+                    continue;
                 }
                 let Some(WallTouch {
                     point,
