@@ -625,25 +625,8 @@ mod avx2_forces {
                         d.point = point;
                     }
                 }
-                s.active = true;
-                s.onset = onset;
-                s.history = b.history.get(k);
-                if onset {
-                    d.onset_normal_speed = b.v_n[k];
-                    d.onset_tangential_speed = b.v_t.get(k).length();
-                }
-                if !full {
-                    let arm = b.arm[k];
-                    out[slot] = WallOut {
-                        force: b.force.get(k),
-                        torque: arm * b.torque_per_arm.get(k),
-                    };
-                }
-                if c.shared.detail {
-                    d.normal = b.n.get(k);
-                    d.overlap = b.overlap[k];
-                    d.normal_force = b.f_n[k];
-                }
+                let o = (!full).then(|| &mut out[slot]);
+                scatter_wall_lane(b, k, s, o, d, c.shared.detail);
             }
         }
     }
@@ -947,26 +930,42 @@ pub(super) fn wall_chunk_batched<const E: u16>(
         // ---- scatter
         for k in 0..b.len {
             let q = b.index[k] as usize;
-            let s = &mut slots[q];
-            let onset = !s.active;
-            s.active = true;
-            s.onset = onset;
-            s.history = b.history.get(k);
             let d = &mut detail[q];
-            if onset {
-                d.onset_normal_speed = b.v_n[k];
-                d.onset_tangential_speed = b.v_t.get(k).length();
-            }
-            let arm = b.arm[k];
-            out[q] = WallOut {
-                force: b.force.get(k),
-                torque: arm * b.torque_per_arm.get(k),
-            };
-            if c.shared.detail {
-                d.normal = b.n.get(k);
-                d.overlap = b.overlap[k];
-                d.normal_force = b.f_n[k];
-            }
+            scatter_wall_lane(b, k, &mut slots[q], Some(&mut out[q]), d, c.shared.detail);
         }
+    }
+}
+
+/// Lane `k` of a batch of wall slots back into its slot `s`: the contact state, the onset
+/// speeds, the force and torque (unless `out` is `None`: the caller wrote them as rows) and,
+/// on detail steps, the record values.
+#[inline(always)]
+fn scatter_wall_lane(
+    b: &Batch,
+    k: usize,
+    s: &mut WallContact,
+    out: Option<&mut WallOut>,
+    d: &mut WallDetail,
+    detail: bool,
+) {
+    let onset = !s.active;
+    s.active = true;
+    s.onset = onset;
+    s.history = b.history.get(k);
+    if onset {
+        d.onset_normal_speed = b.v_n[k];
+        d.onset_tangential_speed = b.v_t.get(k).length();
+    }
+    if let Some(o) = out {
+        let arm = b.arm[k];
+        *o = WallOut {
+            force: b.force.get(k),
+            torque: arm * b.torque_per_arm.get(k),
+        };
+    }
+    if detail {
+        d.normal = b.n.get(k);
+        d.overlap = b.overlap[k];
+        d.normal_force = b.f_n[k];
     }
 }
