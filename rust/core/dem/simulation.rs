@@ -300,6 +300,8 @@ pub struct Simulation {
     avx2: bool,
     /// Evaluate contacts in batches ([`Batch`]; bitwise the same results as one at a time).
     batched: bool,
+    /// See [`PairCtx::pairs_hertz`] (set with the contact constants).
+    pairs_hertz: bool,
     pub(crate) record_every: u64,
     pub(crate) record_onsets: bool,
     /// Outlet plane (point, unit normal towards the kept side).
@@ -396,6 +398,9 @@ struct PairCtx<'a> {
     avx2: bool,
     /// Evaluate contacts in batches.
     batched: bool,
+    /// Every pair follows the Hertz law ([`LawKind::Hertz`]), so with AVX2 the batched pair
+    /// kernel copies the constants without testing the law of each.
+    pairs_hertz: bool,
 }
 
 /// Read-only context of the wall kernels (run in the force phase, next to the pairs).
@@ -427,6 +432,8 @@ struct ParticleCtx<'a> {
     wall_stride: usize,
     /// Write the per-particle records (contact force sum, coordination numbers).
     detail: bool,
+    /// Advance four particles per AVX2 instruction (`batch::advance4`).
+    avx2: bool,
 }
 
 /// Tangential force with Mindlin history, rotated onto the current tangent plane, and the
@@ -996,6 +1003,107 @@ fn wall_chunk<const E: u16>(
     }
 }
 
+/// What the particle phase reads to sum the forces on a particle (see [`Gather::particle`]).
+struct Gather<'a> {
+    c: &'a ParticleCtx<'a>,
+    /// The chunk's slices (index k = particle − first).
+    radius: &'a [f64],
+    offset: &'a [u32],
+    pair_start: &'a [u32],
+    /// The pair arrays, cut to one length.
+    pair_active: &'a [bool],
+    pair_out: &'a [PairOut],
+    pair_rolling: &'a [Vec3],
+    slots: &'a [WallContact],
+    wall_out: &'a [WallOut],
+    stride: usize,
+}
+
+impl Gather<'_> {
+    /// Force and torque on particle k of the chunk, its coordination numbers (pairs, walls)
+    /// and its wall onsets: the pairs in list order, then the wall slots in slot order.
+    #[inline(always)]
+    fn particle<const E: u16>(&self, k: usize) -> (Vec3, Vec3, u32, u32, u32) {
+        let Gather {
+            c,
+            radius,
+            offset,
+            pair_start,
+            pair_active,
+            pair_out,
+            pair_rolling,
+            slots,
+            wall_out,
+            stride,
+        } = *self;
+        let rotation = on::<E>(c.effects, Effect::Rotation);
+        let rolling = on::<E>(c.effects, Effect::RollingResistance);
+        let planar = on::<E>(c.effects, Effect::Planar);
+        let mut f = Vec3::ZERO;
+        let mut t = Vec3::ZERO;
+        let mut z = 0u32;
+        // pairs in increasing index order: first those where the particle is j (their i is
+        // smaller, so their indices come first), listed in the CSR ...
+        for &e in &c.csr_entry[offset[k] as usize..offset[k + 1] as usize] {
+            let e = e as usize;
+            let Some(true) = pair_active.get(e) else {
+                continue;
+            };
+            let p = &pair_out[e];
+            z += 1;
+            f -= p.force;
+            if rotation {
+                let arm = radius[k] - 0.5 * p.overlap;
+                t += arm * p.torque_per_arm;
+                if rolling {
+                    t -= pair_rolling[e];
+                }
+            }
+        }
+        // ... then those where it is i: a contiguous range of the sorted pair list
+        let own = pair_start[k] as usize..pair_start[k + 1] as usize;
+        for (e, (&on, p)) in pair_active[own.clone()]
+            .iter()
+            .zip(&pair_out[own.clone()])
+            .enumerate()
+        {
+            if !on {
+                continue;
+            }
+            z += 1;
+            f += p.force;
+            if rotation {
+                let arm = radius[k] - 0.5 * p.overlap;
+                t += arm * p.torque_per_arm;
+                if rolling {
+                    t += pair_rolling[own.start + e];
+                }
+            }
+        }
+        if planar {
+            // upright cartridges cannot climb on each other: particle forces act in the plane
+            f.z = 0.0;
+        }
+        let mut zw = 0u32;
+        let mut onsets = 0u32;
+        let own_slots = k * stride..(k + 1) * stride;
+        for (s, o) in slots[own_slots.clone()].iter().zip(&wall_out[own_slots]) {
+            if s.wall == NO_WALL {
+                break;
+            }
+            if s.active {
+                zw += 1;
+                if s.onset {
+                    onsets += 1;
+                }
+                f += o.force;
+                t += o.torque;
+            }
+        }
+        (f, t, z, zw, onsets)
+    }
+}
+
 /// Particle phase on one chunk of particles starting at `first`. Returns (largest squared
 /// displacement since the last rebuild, any non-finite value, wall onsets).
 #[allow(clippy::too_many_arguments)]
@@ -1048,74 +1156,66 @@ fn particle_chunk<const E: u16>(
         &[]
     };
     let stride = c.wall_stride;
-    for (k, (slots, outs)) in slots
-        .chunks_exact(stride)
-        .zip(wall_out.chunks_exact(stride))
-        .take(len)
-        .enumerate()
-    {
-        if !alive[k] {
+    let (slots, wall_out) = (&slots[..len * stride], &wall_out[..len * stride]);
+    let g = Gather {
+        c,
+        radius,
+        offset,
+        pair_start,
+        pair_active,
+        pair_out,
+        pair_rolling,
+        slots,
+        wall_out,
+        stride,
+    };
+    let gather = |k: usize| g.particle::<E>(k);
+    let mut k = 0;
+    while k < len {
+        #[cfg(target_arch = "x86_64")]
+        if c.avx2 && k + 4 <= len && alive[k..k + 4].iter().all(|&a| a) {
+            // four particles: gathered one by one, advanced four per instruction
+            let mut ft = [[0.0; 4]; 6];
+            for l in 0..4 {
+                let (f, t, z, zw, onsets) = gather(k + l);
+                wall_onsets += onsets;
+                if c.detail {
+                    force_sum[k + l] = f;
+                    coordination[k + l] = z;
+                    wall_coordination[k + l] = zw;
+                }
+                for (q, value) in [f.x, f.y, f.z, t.x, t.y, t.z].into_iter().enumerate() {
+                    ft[q][l] = value;
+                }
+            }
+            // SAFETY: `avx2` is set only when the CPU reported AVX2.
+            let (disp2, p) = unsafe {
+                batch::advance4::<E>(
+                    &ft,
+                    &mut position[k..k + 4],
+                    &mut velocity[k..k + 4],
+                    &mut omega[k..k + 4],
+                    &reference[k..k + 4],
+                    &inv_mass[k..k + 4],
+                    &inv_inertia[k..k + 4],
+                    gravity,
+                    c.dt,
+                    c.effects,
+                )
+            };
+            probe.x += p;
+            if disp2 > max_disp2 {
+                max_disp2 = disp2;
+            }
+            k += 4;
             continue;
         }
-        let mut f = Vec3::ZERO;
-        let mut t = Vec3::ZERO;
-        let mut z = 0u32;
-        // pairs in increasing index order: first those where the particle is j (their i is
-        // smaller, so their indices come first), listed in the CSR ...
-        for &e in &c.csr_entry[offset[k] as usize..offset[k + 1] as usize] {
-            let e = e as usize;
-            let Some(true) = pair_active.get(e) else {
-                continue;
-            };
-            let p = &pair_out[e];
-            z += 1;
-            f -= p.force;
-            if rotation {
-                let arm = radius[k] - 0.5 * p.overlap;
-                t += arm * p.torque_per_arm;
-                if rolling {
-                    t -= pair_rolling[e];
-                }
-            }
+        if !alive[k] {
+            k += 1;
+            continue;
         }
-        // ... then those where it is i: a contiguous range of the sorted pair list
-        let own = pair_start[k] as usize..pair_start[k + 1] as usize;
-        for (e, (&on, p)) in pair_active[own.clone()]
-            .iter()
-            .zip(&pair_out[own.clone()])
-            .enumerate()
-        {
-            if !on {
-                continue;
-            }
-            z += 1;
-            f += p.force;
-            if rotation {
-                let arm = radius[k] - 0.5 * p.overlap;
-                t += arm * p.torque_per_arm;
-                if rolling {
-                    t += pair_rolling[own.start + e];
-                }
-            }
-        }
-        if planar {
-            // upright cartridges cannot climb on each other: particle forces act in the plane
-            f.z = 0.0;
-        }
-        let mut zw = 0u32;
-        for (s, o) in slots.iter().zip(outs) {
-            if s.wall == NO_WALL {
-                break;
-            }
-            if s.active {
-                zw += 1;
-                if s.onset {
-                    wall_onsets += 1;
-                }
-                f += o.force;
-                t += o.torque;
-            }
-        }
+        let (f, t, z, zw, onsets) = gather(k);
+        wall_onsets += onsets;
         let (x, v, w) = (position[k], velocity[k], omega[k]);
         if c.detail {
             force_sum[k] = f;
@@ -1141,6 +1241,7 @@ fn particle_chunk<const E: u16>(
         if disp2 > max_disp2 {
             max_disp2 = disp2;
         }
+        k += 1;
     }
     (max_disp2, !probe.is_finite(), wall_onsets)
 }
@@ -1241,6 +1342,7 @@ impl Simulation {
             threads: scene.threads,
             avx2: cpu_has_avx2(),
             batched: true,
+            pairs_hertz: false,
             record_every: scene.record_every,
             record_onsets: scene.record_onsets,
             removal_plane: scene.removal_plane.map(|(p, n)| (p, n / n.length())),
@@ -1405,6 +1507,7 @@ impl Simulation {
                 self.model, &self.laws, law, r_star, m_star,
             ));
         }
+        self.pairs_hertz = self.pair_const.iter().all(|k| k.kind == LawKind::Hertz);
         let stride = self.wall_stride;
         for (k, s) in self.wall_slots.iter_mut().enumerate() {
             if s.wall == NO_WALL {
@@ -1595,6 +1698,7 @@ impl Simulation {
                 detail: self.detail,
                 avx2,
                 batched: self.batched,
+                pairs_hertz: self.pairs_hertz,
             };
             let wall_ctx = WallCtx {
                 shared: pair_ctx,
@@ -1716,6 +1820,7 @@ impl Simulation {
                 dt: self.dt,
                 wall_stride: stride,
                 detail: self.detail,
+                avx2,
             };
             if parallel {
                 // the blocks of the force phase (see there); one result per block

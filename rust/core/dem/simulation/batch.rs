@@ -139,6 +139,17 @@ impl Batch {
         !hertz
     }
 
+    /// [`Batch::set_constants`] for a contact known to follow the Hertz law, with AVX2.
+    #[inline(always)]
+    fn set_hertz_constants(&mut self, k: usize, konst: &ContactConst) {
+        self.hertz[k] = u64::MAX;
+        self.f_el[k] = konst.f_el;
+        self.c_n[k] = konst.c_n;
+        self.k_t[k] = konst.k_t;
+        self.ct_ratio[k] = konst.ct_ratio;
+        self.mu[k] = konst.mu;
+    }
+
     /// Law values of the contacts whose law is pending (see [`Batch::set_constants`]).
     #[inline(always)]
     fn set_laws<const E: u16>(&mut self, c: &PairCtx<'_>, konst: impl Fn(usize) -> ContactConst) {
@@ -239,6 +250,9 @@ fn contact_forces<const E: u16>(b: &mut Batch, c: &PairCtx<'_>) {
 
 /// [`contact_forces`] on four contacts per instruction (AVX2). The lanes past the batch's
 /// length compute on stale values that nothing reads.
+#[cfg(target_arch = "x86_64")]
+pub(super) use avx2_forces::advance4;
+
 #[cfg(target_arch = "x86_64")]
 mod avx2_forces {
     use super::*;
@@ -353,6 +367,101 @@ mod avx2_forces {
             y: _mm256_shuffle_pd::<0b0101>(m1, m3),
             z: _mm256_shuffle_pd::<0b1010>(m2, m3),
         }
+    }
+
+    /// Lanes back to four consecutive vectors at `p`: the inverse of [`load_aos4`].
+    #[inline(always)]
+    unsafe fn store_aos4(p: *mut Vec3, v: V4) {
+        let f = p as *mut f64;
+        let m1 = _mm256_unpacklo_pd(v.x, v.y); // x0 y0 x2 y2
+        let m3 = _mm256_unpackhi_pd(v.y, v.z); // y1 z1 y3 z3
+        let m2 = _mm256_shuffle_pd::<0b1010>(v.z, v.x); // z0 x1 z2 x3
+        _mm256_storeu_pd(f, _mm256_permute2f128_pd::<0x20>(m1, m2));
+        _mm256_storeu_pd(f.add(4), _mm256_blend_pd::<0b1100>(m3, m1));
+        _mm256_storeu_pd(f.add(8), _mm256_permute2f128_pd::<0x31>(m2, m3));
+    }
+
+    /// The leapfrog update of four consecutive alive particles, four per instruction: the
+    /// operations of the particle phase's update, in its order, on each lane. `ft` holds
+    /// the lanes of the force and torque (x, y, z of each). Returns the largest squared
+    /// displacement from `reference` (a NaN one is ignored, as by the scalar update) and the
+    /// finiteness probe (0, or NaN when a value is not finite).
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    pub(in crate::dem::simulation) unsafe fn advance4<const E: u16>(
+        ft: &[[f64; 4]; 6],
+        x: &mut [Vec3],
+        v: &mut [Vec3],
+        w: &mut [Vec3],
+        reference: &[Vec3],
+        inv_mass: &[f64],
+        inv_inertia: &[f64],
+        gravity: Vec3,
+        dt: f64,
+        effects: EffectSet,
+    ) -> (f64, f64) {
+        let rotation = on::<E>(effects, Effect::Rotation);
+        let planar = on::<E>(effects, Effect::Planar);
+        let (x, v, w) = (&mut x[..4], &mut v[..4], &mut w[..4]);
+        let (reference, inv_mass, inv_inertia) =
+            (&reference[..4], &inv_mass[..4], &inv_inertia[..4]);
+        let zero = _mm256_setzero_pd();
+        let dt = _mm256_set1_pd(dt);
+        let lane = |q: usize| _mm256_loadu_pd(ft[q].as_ptr());
+        let f = V4 {
+            x: lane(0),
+            y: lane(1),
+            z: lane(2),
+        };
+        let g = V4 {
+            x: _mm256_set1_pd(gravity.x),
+            y: _mm256_set1_pd(gravity.y),
+            z: _mm256_set1_pd(gravity.z),
+        };
+        // v + (f m⁻¹ + g) Δt, x + v Δt
+        let a = add(scale(_mm256_loadu_pd(inv_mass.as_ptr()), f), g);
+        let v_new = add(load_aos4(v.as_ptr()), scale(dt, a));
+        let x_new = add(load_aos4(x.as_ptr()), scale(dt, v_new));
+        store_aos4(v.as_mut_ptr(), v_new);
+        store_aos4(x.as_mut_ptr(), x_new);
+        let s = add(x_new, v_new);
+        let mut probe = _mm256_mul_pd(_mm256_add_pd(_mm256_add_pd(s.x, s.y), s.z), zero);
+        if rotation {
+            let t = V4 {
+                x: lane(3),
+                y: lane(4),
+                z: lane(5),
+            };
+            // ω + T (I⁻¹ Δt)
+            let k = _mm256_mul_pd(_mm256_loadu_pd(inv_inertia.as_ptr()), dt);
+            let mut w_new = add(load_aos4(w.as_ptr()), scale(k, t));
+            if planar {
+                w_new.x = zero;
+                w_new.y = zero;
+            }
+            store_aos4(w.as_mut_ptr(), w_new);
+            let sw = _mm256_add_pd(_mm256_add_pd(w_new.x, w_new.y), w_new.z);
+            probe = _mm256_add_pd(probe, _mm256_mul_pd(sw, zero));
+        }
+        let d = sub(x_new, load_aos4(reference.as_ptr()));
+        let disp2 = lanes(dot(d, d));
+        let p = lanes(probe);
+        let mut max = 0.0;
+        for q in disp2 {
+            if q > max {
+                max = q;
+            }
+        }
+        (max, (p[0] + p[1]) + (p[2] + p[3]))
+    }
+
+    /// The lanes of `v` as an array.
+    #[inline(always)]
+    unsafe fn lanes(v: __m256d) -> [f64; 4] {
+        let mut a = [0.0; 4];
+        _mm256_storeu_pd(a.as_mut_ptr(), v);
+        a
     }
 
     /// 4×4 transpose: lane l of row k becomes lane k of row l.
@@ -763,6 +872,8 @@ pub(super) fn pair_chunk_batched<const E: u16>(
     b: &mut Batch,
 ) -> u32 {
     let rotation = on::<E>(c.effects, Effect::Rotation);
+    // every pair's law is evaluated by the AVX2 force pass: no per-pair test of the law
+    let hertz = c.avx2 && c.pairs_hertz;
     let mut onsets = 0u32;
     let len = chunk.len();
     let (active, out, detail, konst) = (
@@ -799,7 +910,11 @@ pub(super) fn pair_chunk_batched<const E: u16>(
                 b.omega_j.set(k, c.omega[j]);
             }
             b.history.set(k, p.history);
-            pending |= b.set_constants(k, &konst[e], c);
+            if hertz {
+                b.set_hertz_constants(k, &konst[e]);
+            } else {
+                pending |= b.set_constants(k, &konst[e], c);
+            }
         }
         // ---- overlaps and normals, laws, forces
         pair_geometry::<E>(b, c);
