@@ -8,7 +8,8 @@
 //!    shared accumulator);
 //! 3. **particle phase** — for every particle: the pair forces are gathered in the fixed order
 //!    of the particle's pair list, then its wall slots' forces in slot order, and the particle
-//!    is advanced: v += F/m Δt, x += v Δt, ω += T/I Δt.
+//!    is advanced: v += F/m Δt, x += v Δt, ω += T/I Δt (with AVX2, four particles per
+//!    instruction, the same operations per lane: `batch::advance4`).
 //!
 //! With several threads, the particles are cut into one contiguous block per thread (at
 //! rebuild, `part_cuts`); in the force phase a thread takes the pairs whose first particle is
