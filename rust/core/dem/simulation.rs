@@ -219,8 +219,9 @@ pub(crate) struct WallContact {
     /// the batched wall kernel skips it. Transient: rewritten every AVX2 step, not saved.
     pub(crate) planar_pass: bool,
     pub(crate) history: Vec3,
-    /// Law constants of this particle against this wall (derived, not checkpointed).
-    pub(crate) k: ContactConst,
+    /// Law constants of this particle against this wall: index into the contact table
+    /// (`Simulation::contact_table`; derived, not checkpointed).
+    pub(crate) k: u32,
 }
 
 impl Default for WallContact {
@@ -231,7 +232,7 @@ impl Default for WallContact {
             onset: false,
             planar_pass: false,
             history: Vec3::ZERO,
-            k: ContactConst::default(),
+            k: 0,
         }
     }
 }
@@ -322,8 +323,13 @@ pub struct Simulation {
     pair_detail: Vec<PairDetail>,
     /// Rolling-resistance torque on i (−this on j) of each pair, N·m (`rolling_resistance`).
     pair_rolling: Vec<Vec3>,
-    /// Law constants of each pair (derived at rebuild and restore).
-    pair_const: Vec<ContactConst>,
+    /// Law constants of each pair: index into `contact_table` (derived at rebuild and
+    /// restore).
+    pair_const: Vec<u32>,
+    /// The distinct law constants of the pairs and wall slots (entry 0 unused): on a table of
+    /// equal spheres a handful, so the constants stay in L1 instead of 64 bytes per contact
+    /// streaming through the caches every step.
+    contact_table: Vec<ContactConst>,
     pub(crate) wall_slots: Vec<WallContact>,
     wall_out: Vec<WallOut>,
     wall_detail: Vec<WallDetail>,
@@ -382,6 +388,8 @@ impl std::fmt::Debug for Simulation {
 /// Read-only context of the pair kernel; the wall kernels share it (see [`WallCtx`]).
 #[derive(Clone, Copy)]
 struct PairCtx<'a> {
+    /// The law constants the contacts index (`Simulation::contact_table`).
+    table: &'a [ContactConst],
     position: &'a [Vec3],
     velocity: &'a [Vec3],
     omega: &'a [Vec3],
@@ -760,7 +768,7 @@ fn pair_chunk<const E: u16>(
     out: &mut [PairOut],
     detail: &mut [PairDetail],
     rolling: &mut [Vec3],
-    konst: &[ContactConst],
+    konst: &[u32],
     c: &PairCtx<'_>,
     batch: &mut Batch,
 ) -> u32 {
@@ -776,7 +784,7 @@ fn pair_chunk<const E: u16>(
         .zip(rolling.iter_mut())
         .zip(konst)
     {
-        onsets += pair_kernel::<E>(p, a, k, o, d, r, c) as u32;
+        onsets += pair_kernel::<E>(p, a, &c.table[*k as usize], o, d, r, c) as u32;
     }
     onsets
 }
@@ -821,7 +829,7 @@ mod simd {
         out: &mut [PairOut],
         detail: &mut [PairDetail],
         rolling: &mut [Vec3],
-        konst: &[ContactConst],
+        konst: &[u32],
         c: &PairCtx<'_>,
         batch: &mut Batch
     ) -> u32);
@@ -913,14 +921,10 @@ fn wall_kernel<const E: u16>(
         detail.onset_tangential_speed = v_t.length();
         detail.point = point;
     }
-    let (f_el, c_n, k_t) = law_at::<E>(
-        &s.k,
-        c.shared.model,
-        c.shared.laws,
-        c.shared.effects,
-        overlap,
-    );
-    let (ct_ratio, mu, law) = (s.k.ct_ratio, s.k.mu, s.k.law as usize);
+    let kk = &c.shared.table[s.k as usize];
+    let (f_el, c_n, k_t) =
+        law_at::<E>(kk, c.shared.model, c.shared.laws, c.shared.effects, overlap);
+    let (ct_ratio, mu, law) = (kk.ct_ratio, kk.mu, kk.law as usize);
     let mut f_n = f_el + c_n * v_n;
     if c.shared.clamp && f_n < 0.0 {
         f_n = 0.0;
@@ -1360,6 +1364,7 @@ impl Simulation {
             pair_detail: Vec::new(),
             pair_rolling: Vec::new(),
             pair_const: Vec::new(),
+            contact_table: Vec::new(),
             wall_slots: Vec::new(),
             wall_out: Vec::new(),
             wall_detail: Vec::new(),
@@ -1496,6 +1501,22 @@ impl Simulation {
         self.wall_detail.clear();
         self.wall_detail.resize(n_slots, WallDetail::default());
         let nm = self.n_materials;
+        // ContactConst::new is a function of (law, R*, m*) for the scene's model: one table
+        // entry per distinct triple
+        let (model, laws) = (self.model, &self.laws);
+        let table = &mut self.contact_table;
+        table.clear();
+        table.push(ContactConst::default());
+        let mut index: std::collections::HashMap<(usize, u64, u64), u32> =
+            std::collections::HashMap::new();
+        let mut entry = |law: usize, r_star: f64, m_star: f64| -> u32 {
+            *index
+                .entry((law, r_star.to_bits(), m_star.to_bits()))
+                .or_insert_with(|| {
+                    table.push(ContactConst::new(model, laws, law, r_star, m_star));
+                    (table.len() - 1) as u32
+                })
+        };
         self.pair_const.clear();
         for p in self.pairs.iter_mut() {
             let (i, j) = (p.i as usize, p.j as usize);
@@ -1504,11 +1525,8 @@ impl Simulation {
             let r_star = self.radius[i] * self.radius[j] / r_sum;
             let m_star = self.mass[i] * self.mass[j] / (self.mass[i] + self.mass[j]);
             let law = self.material[i] as usize * nm + self.material[j] as usize;
-            self.pair_const.push(ContactConst::new(
-                self.model, &self.laws, law, r_star, m_star,
-            ));
+            self.pair_const.push(entry(law, r_star, m_star));
         }
-        self.pairs_hertz = self.pair_const.iter().all(|k| k.kind == LawKind::Hertz);
         let stride = self.wall_stride;
         for (k, s) in self.wall_slots.iter_mut().enumerate() {
             if s.wall == NO_WALL {
@@ -1516,8 +1534,13 @@ impl Simulation {
             }
             let i = k / stride;
             let law = self.material[i] as usize * nm + self.walls[s.wall as usize].material;
-            s.k = ContactConst::new(self.model, &self.laws, law, self.radius[i], self.mass[i]);
+            s.k = entry(law, self.radius[i], self.mass[i]);
         }
+        let table = &self.contact_table;
+        self.pairs_hertz = self
+            .pair_const
+            .iter()
+            .all(|&k| table[k as usize].kind == LawKind::Hertz);
     }
 
     /// Rebuild the Verlet lists (pairs, wall slots, gather lists), carrying contact history over.
@@ -1686,6 +1709,7 @@ impl Simulation {
         // ---- force phase: every pair and every wall slot writes its own record only
         {
             let pair_ctx = PairCtx {
+                table: &self.contact_table,
                 position: &self.position,
                 velocity: &self.velocity,
                 omega: &self.omega,
@@ -1716,7 +1740,7 @@ impl Simulation {
                     ),
                     &'c mut [Vec3],
                 ),
-                &'c [ContactConst],
+                &'c [u32],
             );
             let kernel =
                 |(((((chunk, active), out), detail), rolling), konst): PairChunk<'_>| -> u32 {

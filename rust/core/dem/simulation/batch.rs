@@ -580,7 +580,9 @@ mod avx2_forces {
                 let take = plane.1.is_some()
                     && (0..4).all(|l| {
                         let s = &slots[s0 + l * stride];
-                        s.wall == w && alive[g + l] && s.k.kind == LawKind::Hertz
+                        s.wall == w
+                            && alive[g + l]
+                            && c.shared.table[s.k as usize].kind == LawKind::Hertz
                     });
                 for l in 0..4 {
                     slots[s0 + l * stride].planar_pass = take;
@@ -640,7 +642,8 @@ mod avx2_forces {
                     },
                 );
                 // f_el, k_t, c_n, c_t/c_n are 32 contiguous bytes of a `ContactConst`
-                let krow = |l: usize| _mm256_loadu_pd(&sp(l).k.f_el);
+                let kp = |l: usize| &c.shared.table[sp(l).k as usize];
+                let krow = |l: usize| _mm256_loadu_pd(&kp(l).f_el);
                 let [f_el, k_t, c_n, ct_ratio] = transpose(krow(0), krow(1), krow(2), krow(3));
                 st(&mut b.f_el, k, f_el);
                 st(&mut b.k_t, k, k_t);
@@ -649,7 +652,7 @@ mod avx2_forces {
                 st(
                     &mut b.mu,
                     k,
-                    _mm256_setr_pd(sp(0).k.mu, sp(1).k.mu, sp(2).k.mu, sp(3).k.mu),
+                    _mm256_setr_pd(kp(0).mu, kp(1).mu, kp(2).mu, kp(3).mu),
                 );
                 _mm256_storeu_si256(
                     b.hertz.as_mut_ptr().add(k) as *mut __m256i,
@@ -867,7 +870,7 @@ pub(super) fn pair_chunk_batched<const E: u16>(
     active: &mut [bool],
     out: &mut [PairOut],
     detail: &mut [PairDetail],
-    konst: &[ContactConst],
+    konst: &[u32],
     c: &PairCtx<'_>,
     b: &mut Batch,
 ) -> u32 {
@@ -911,15 +914,15 @@ pub(super) fn pair_chunk_batched<const E: u16>(
             }
             b.history.set(k, p.history);
             if hertz {
-                b.set_hertz_constants(k, &konst[e]);
+                b.set_hertz_constants(k, &c.table[konst[e] as usize]);
             } else {
-                pending |= b.set_constants(k, &konst[e], c);
+                pending |= b.set_constants(k, &c.table[konst[e] as usize], c);
             }
         }
         // ---- overlaps and normals, laws, forces
         pair_geometry::<E>(b, c);
         if pending {
-            b.set_laws::<E>(c, |e| konst[e]);
+            b.set_laws::<E>(c, |e| c.table[konst[e] as usize]);
         }
         contact_forces::<E>(b, c);
         // ---- scatter
@@ -1030,7 +1033,7 @@ pub(super) fn wall_chunk_batched<const E: u16>(
                     b.spin.set(k, arm * w);
                 }
                 b.history.set(k, s.history);
-                pending |= b.set_constants(k, &s.k, &c.shared);
+                pending |= b.set_constants(k, &c.shared.table[s.k as usize], &c.shared);
                 if !s.active || c.shared.detail {
                     // recorded at onset and on detail steps
                     detail[q].point = point;
@@ -1039,7 +1042,7 @@ pub(super) fn wall_chunk_batched<const E: u16>(
         }
         // ---- laws, forces
         if pending {
-            b.set_laws::<E>(&c.shared, |q| slots[q].k);
+            b.set_laws::<E>(&c.shared, |q| c.shared.table[slots[q].k as usize]);
         }
         contact_forces::<E>(b, &c.shared);
         // ---- scatter
