@@ -25,8 +25,9 @@
 //! set (with and without `planar`) gets a specialised step without effect tests in the inner
 //! loops, any other set runs the generic one. Law constants that depend only on the two bodies
 //! (E*, G*, √R*, m*, damping prefactor, friction) are derived once per neighbour-list rebuild
-//! (`ContactConst`), so a contact costs three square roots (distance, √δ, δ^{1/4}) and one
-//! division, plus a square root and two divisions in gross sliding.
+//! (`ContactConst`, one table entry per distinct law, R* and m*, which pairs and wall slots
+//! index), so a contact costs three square roots (distance, √δ, δ^{1/4}) and one division,
+//! plus a square root and two divisions in gross sliding.
 //!
 //! Contacts are evaluated in batches (module `batch`): a chunk's contacts are found and
 //! gathered first, then their geometry, laws and forces are computed in short loops (four
