@@ -651,27 +651,42 @@ fn wall_touch<const E: u16>(
         WallState::default()
     };
     let Some((point, out_normal, dist)) = wall_hit(wall, x, moving.then_some(ws.offset), r) else {
-        if s.active {
-            s.active = false;
-            s.history = Vec3::ZERO;
-        }
-        s.onset = false;
+        end_wall_contact(s);
         return None;
     };
     let n = -out_normal; // from the particle towards the wall
-    let mut wall_v = ws.velocity;
-    if on::<E>(c.shared.effects, Effect::Belt) {
-        let s_v = wall.surface_velocity;
-        let belt = s_v - s_v.dot(n) * n;
-        wall_v = if moving { wall_v + belt } else { belt };
-    }
     Some(WallTouch {
         point,
         n,
         overlap: r - dist,
         arm: dist.max(0.0),
-        wall_v,
+        wall_v: wall_velocity::<E>(wall, ws, n, c.shared.effects),
     })
+}
+
+/// Slot `s` out of reach of its wall: ends a contact that was active.
+#[inline(always)]
+fn end_wall_contact(s: &mut WallContact) {
+    if s.active {
+        s.active = false;
+        s.history = Vec3::ZERO;
+    }
+    s.onset = false;
+}
+
+/// Velocity of the wall's material at a contact with normal `n` (particle towards wall),
+/// m/s: the wall's motion (`ws`, zero without `moving_walls`) plus the belt's surface velocity
+/// tangent to the contact.
+#[inline(always)]
+fn wall_velocity<const E: u16>(wall: &Wall, ws: WallState, n: Vec3, effects: EffectSet) -> Vec3 {
+    let moving = on::<E>(effects, Effect::MovingWalls);
+    let mut wall_v = ws.velocity;
+    if on::<E>(effects, Effect::Belt) {
+        let s_v = wall.surface_velocity;
+        let belt = s_v - s_v.dot(n) * n;
+        wall_v = if moving { wall_v + belt } else { belt };
+    }
+    wall_v
 }
 
 /// Force of one candidate pair; returns whether a contact began.

@@ -130,19 +130,15 @@ impl Batch {
     #[inline(always)]
     fn set_constants(&mut self, k: usize, konst: &ContactConst, c: &PairCtx<'_>) -> bool {
         let hertz = c.avx2 && konst.kind == LawKind::Hertz;
-        self.hertz[k] = if hertz { u64::MAX } else { 0 };
-        self.f_el[k] = konst.f_el;
-        self.c_n[k] = konst.c_n;
-        self.k_t[k] = konst.k_t;
-        self.ct_ratio[k] = konst.ct_ratio;
-        self.mu[k] = konst.mu;
+        self.copy_constants(k, konst, hertz);
         !hertz
     }
 
-    /// [`Batch::set_constants`] for a contact known to follow the Hertz law, with AVX2.
+    /// The constants of contact `k`, with the `hertz` mask as given (see
+    /// [`Batch::set_constants`]; a caller that knows the law skips its test).
     #[inline(always)]
-    fn set_hertz_constants(&mut self, k: usize, konst: &ContactConst) {
-        self.hertz[k] = u64::MAX;
+    fn copy_constants(&mut self, k: usize, konst: &ContactConst, hertz: bool) {
+        self.hertz[k] = if hertz { u64::MAX } else { 0 };
         self.f_el[k] = konst.f_el;
         self.c_n[k] = konst.c_n;
         self.k_t[k] = konst.k_t;
@@ -248,11 +244,12 @@ fn contact_forces<const E: u16>(b: &mut Batch, c: &PairCtx<'_>) {
     }
 }
 
-/// [`contact_forces`] on four contacts per instruction (AVX2). The lanes past the batch's
-/// length compute on stale values that nothing reads.
 #[cfg(target_arch = "x86_64")]
 pub(super) use avx2_forces::advance4;
 
+/// [`contact_forces`] on four contacts per instruction (AVX2), and the other lane kernels
+/// (the plane pass, the four-particle update). The lanes past the batch's length compute on
+/// stale values that nothing reads.
 #[cfg(target_arch = "x86_64")]
 mod avx2_forces {
     use super::*;
@@ -506,12 +503,7 @@ mod avx2_forces {
             WallState::default()
         };
         let n = -normal;
-        let mut wall_v = ws.velocity;
-        if on::<E>(c.shared.effects, Effect::Belt) {
-            let s_v = wall.surface_velocity;
-            let belt = s_v - s_v.dot(n) * n;
-            wall_v = if moving { wall_v + belt } else { belt };
-        }
+        let wall_v = wall_velocity::<E>(wall, ws, n, c.shared.effects);
         let bc = |v: Vec3| V4 {
             x: _mm256_set1_pd(v.x),
             y: _mm256_set1_pd(v.y),
@@ -603,12 +595,7 @@ mod avx2_forces {
                     // out of reach: `wall_touch`'s reset
                     for l in 0..4 {
                         if m >> l & 1 == 0 {
-                            let s = &mut slots[s0 + l * stride];
-                            if s.active {
-                                s.active = false;
-                                s.history = Vec3::ZERO;
-                            }
-                            s.onset = false;
+                            end_wall_contact(&mut slots[s0 + l * stride]);
                         }
                     }
                     if m == 0 {
@@ -914,7 +901,7 @@ pub(super) fn pair_chunk_batched<const E: u16>(
             }
             b.history.set(k, p.history);
             if hertz {
-                b.set_hertz_constants(k, &c.table[konst[e] as usize]);
+                b.copy_constants(k, &c.table[konst[e] as usize], true);
             } else {
                 pending |= b.set_constants(k, &c.table[konst[e] as usize], c);
             }
