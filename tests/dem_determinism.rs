@@ -152,6 +152,41 @@ fn avx2_and_baseline_agree_with_planar_and_rolling_resistance() {
     }
 }
 
+/// Which wall slots the batched kernels take is listed once per neighbour list and kernel
+/// mode (`list_wall_slots`): switching the kernels mid-run, and removing particles mid-run,
+/// must relist them, so the run stays bitwise that of an uninterrupted one.
+#[test]
+fn switching_kernels_and_removing_particles_mid_run_relists_the_wall_slots() {
+    let mut a = packed_soft(2);
+    let mut b = packed_soft(2);
+    a.step(400).unwrap();
+    b.step(400).unwrap();
+    assert!(b.plane_pass_slots() > 500, "{}", b.plane_pass_slots());
+    b.set_batched(false);
+    for sim in [&mut a, &mut b] {
+        sim.step(300).unwrap();
+        // breaks groups of four of the plane pass
+        for i in [9, 10, 333] {
+            sim.remove_particle(i).unwrap();
+        }
+        sim.step(300).unwrap();
+    }
+    assert_eq!(b.plane_pass_slots(), 0);
+    b.set_batched(true);
+    b.set_avx2(false);
+    a.step(300).unwrap();
+    b.step(300).unwrap();
+    assert_eq!(b.plane_pass_slots(), 0);
+    b.set_avx2(true);
+    a.step(300).unwrap();
+    b.step(300).unwrap();
+    if b.uses_avx2() {
+        assert!(b.plane_pass_slots() > 500, "{}", b.plane_pass_slots());
+    }
+    assert_eq!(bits(&a), bits(&b));
+    assert_eq!(a.onsets(), b.onsets());
+}
+
 /// The batched kernels (several contacts in flight, four per AVX2 instruction in the force
 /// pass) reproduce the one-at-a-time reference kernels bit for bit, on both builds, with the
 /// Hertz–Mindlin and the Hertz–Reissner laws, and with a generic effect set (an oscillating

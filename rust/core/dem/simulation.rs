@@ -35,12 +35,14 @@
 //! dependent operations (δ → √δ → δ^{1/4} → f_n → Coulomb cap → scaling) kept the processor
 //! waiting; in a batch the chains of many contacts overlap. With AVX2, plane-wall slots (the
 //! belt under every sphere) go into the batch four particles at a time, read as lanes rather
-//! than copied contact by contact (`batch::plane_slots`). The one-at-a-time kernels
+//! than copied contact by contact (`batch::plane_slots`). Which wall slots go where is
+//! decided once per neighbour list (`Simulation::list_wall_slots`), not by scanning every
+//! slot in every step. The one-at-a-time kernels
 //! (`pair_kernel`, `wall_kernel`) remain the reference, used with rolling resistance, and
 //! the batches reproduce them bit for bit ([`Simulation::set_batched`]).
 //!
 //! What a step writes is split by who reads it: the state the next step needs (`PairContact`,
-//! `WallContact`, 48 and 96 bytes), what the particle phase gathers (`PairOut`, `WallOut`),
+//! `WallContact`, 48 and 40 bytes), what the particle phase gathers (`PairOut`, `WallOut`),
 //! and what only the records read (`PairDetail`, `WallDetail`), written on the last step of
 //! each [`Simulation::step`] call, so the step streams a third fewer cache lines.
 //!
@@ -208,16 +210,17 @@ pub(crate) struct PairOut {
     overlap: f64,
 }
 
-/// A candidate particle–wall contact slot: the state the step carries and the law constants
-/// (96 bytes). Its force and torque go to [`WallOut`], the record-only values to
-/// [`WallDetail`], as for pairs.
+/// A candidate particle–wall contact slot: the state the step carries and the index of its
+/// law constants (40 bytes). Its force and torque go to [`WallOut`], the record-only values
+/// to [`WallDetail`], as for pairs.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct WallContact {
     pub(crate) wall: u32,
     pub(crate) active: bool,
     pub(crate) onset: bool,
-    /// The AVX2 plane pass evaluated this slot in the current step (`batch::plane_slots`), so
-    /// the batched wall kernel skips it. Transient: rewritten every AVX2 step, not saved.
+    /// The AVX2 plane pass evaluates this slot (`batch::plane_slots`), so the batched wall
+    /// kernel does not list it. Set with the wall lists (`Simulation::list_wall_slots`) when
+    /// the neighbour lists or the step's mode change; derived, not saved.
     pub(crate) planar_pass: bool,
     pub(crate) history: Vec3,
     /// Law constants of this particle against this wall: index into the contact table
@@ -353,6 +356,9 @@ pub struct Simulation {
     /// `PARTICLE_CHUNK`, pair boundaries (the first pair whose i is in the next block,
     /// rounded) at multiples of `PAIR_CHUNK`.
     part_cuts: Vec<(usize, usize)>,
+    /// The wall slots of the batched kernels, listed once per neighbour list (see
+    /// [`Simulation::list_wall_slots`]).
+    wall_lists: WallLists,
     grid: CellGrid,
     candidate_scratch: Vec<(u32, u32)>,
     old_pairs: Vec<PairContact>,
@@ -491,6 +497,33 @@ struct ForcePart<'a> {
     slots: &'a mut [WallContact],
     wall_out: &'a mut [WallOut],
     wall_detail: &'a mut [WallDetail],
+}
+
+/// The wall slots the batched wall kernel evaluates, listed when the neighbour lists (or the
+/// step's mode) change rather than found by scanning every slot each step. Per block of the
+/// force phase (`cuts`: the block boundaries in both lists).
+#[derive(Debug, Default)]
+struct WallLists {
+    /// Groups of the AVX2 plane pass: (first particle relative to the block's first, slot
+    /// column); the four particles from there hold the same plane with Hertz constants in
+    /// that column and are alive.
+    planes: Vec<(u32, u32)>,
+    /// Every other slot holding a wall, of alive particles: (particle, slot), both relative
+    /// to the block's first.
+    rest: Vec<(u32, u32)>,
+    /// Block b's groups are `planes[cuts[b].0..cuts[b + 1].0]`, its slots
+    /// `rest[cuts[b].1..cuts[b + 1].1]`.
+    cuts: Vec<(usize, usize)>,
+    /// The (parallel, AVX2, batched) mode the lists were made for; `None` once the neighbour
+    /// lists change.
+    mode: Option<(bool, bool, bool)>,
+}
+
+/// One block's part of the [`WallLists`].
+#[derive(Clone, Copy)]
+struct BlockWalls<'a> {
+    planes: &'a [(u32, u32)],
+    rest: &'a [(u32, u32)],
 }
 
 /// Runs `run` on every part, the first on the calling thread, the others offered to the
@@ -853,6 +886,7 @@ mod simd {
     avx2_dispatch!(wall, wall_chunk_avx2, wall_chunk, (
         c: &WallCtx<'_>,
         first: usize,
+        lists: BlockWalls<'_>,
         slots: &mut [WallContact],
         out: &mut [WallOut],
         detail: &mut [WallDetail],
@@ -989,6 +1023,7 @@ fn wall_kernel<const E: u16>(
 fn wall_chunk<const E: u16>(
     c: &WallCtx<'_>,
     first: usize,
+    lists: BlockWalls<'_>,
     slots: &mut [WallContact],
     out: &mut [WallOut],
     detail: &mut [WallDetail],
@@ -997,7 +1032,7 @@ fn wall_chunk<const E: u16>(
     let stride = c.wall_stride;
     if c.shared.batched && !on::<E>(c.shared.effects, Effect::RollingResistance) && stride <= BATCH
     {
-        wall_chunk_batched::<E>(c, first, slots, out, detail, batch);
+        wall_chunk_batched::<E>(c, first, lists, slots, out, detail, batch);
         return;
     }
     for (k, ((slots, out), detail)) in slots
@@ -1376,6 +1411,7 @@ impl Simulation {
             pairs: Vec::new(),
             pair_active: Vec::new(),
             part_cuts: Vec::new(),
+            wall_lists: WallLists::default(),
             pair_out: Vec::new(),
             pair_detail: Vec::new(),
             pair_rolling: Vec::new(),
@@ -1511,6 +1547,7 @@ impl Simulation {
     /// and wall slot, and the wall slots' output arrays. A pure function of the lists and the
     /// static data (run after a rebuild and a restore).
     pub(crate) fn refresh_contact_constants(&mut self) {
+        self.wall_lists.mode = None;
         let n_slots = self.wall_slots.len();
         self.wall_out.clear();
         self.wall_out.resize(n_slots, WallOut::default());
@@ -1557,6 +1594,82 @@ impl Simulation {
             .pair_const
             .iter()
             .all(|&k| table[k as usize].kind == LawKind::Hertz);
+    }
+
+    /// The [`WallLists`] for the step's mode: per block of the force phase (`parallel`: the
+    /// blocks of `part_cuts`, else one), the groups of the AVX2 plane pass (four
+    /// consecutive alive particles from the block's start, a slot column whose four slots
+    /// hold the same plane wall with Hertz constants; marked `planar_pass`) and every other
+    /// slot of an alive particle. Without AVX2 there are no groups. A pure function of the
+    /// lists, `alive` and the mode, so the kernels find in it exactly the slots a scan of
+    /// every slot would.
+    pub(crate) fn list_wall_slots(&mut self, parallel: bool) {
+        let n = self.position.len();
+        let stride = self.wall_stride;
+        let lists = &mut self.wall_lists;
+        lists.planes.clear();
+        lists.rest.clear();
+        lists.cuts.clear();
+        lists.cuts.push((0, 0));
+        lists.mode = Some((parallel, self.avx2, self.batched));
+        let mut ends = vec![0];
+        if parallel {
+            ends.extend(self.part_cuts.iter().map(|c| c.0));
+        }
+        ends.push(n);
+        let slots = &mut self.wall_slots;
+        let (walls, table, alive) = (&self.walls, &self.contact_table, &self.alive);
+        for s in slots.iter_mut() {
+            s.planar_pass = false;
+        }
+        for block in ends.windows(2) {
+            let (first, last) = (block[0], block[1]);
+            if self.avx2 {
+                let mut g = first;
+                while g + 4 <= last {
+                    for q in 0..stride {
+                        let slot = |l: usize| &slots[(g + l) * stride + q];
+                        if (0..4).all(|l| slot(l).wall == NO_WALL) {
+                            // the four particles' lists end here
+                            break;
+                        }
+                        let w = slot(0).wall;
+                        let plane = matches!(
+                            walls.get(w as usize).map(|w| &w.shape),
+                            Some(WallShape::Plane { .. })
+                        );
+                        let take = plane
+                            && (0..4).all(|l| {
+                                let s = slot(l);
+                                s.wall == w
+                                    && alive[g + l]
+                                    && table[s.k as usize].kind == LawKind::Hertz
+                            });
+                        if take {
+                            lists.planes.push(((g - first) as u32, q as u32));
+                            for l in 0..4 {
+                                slots[(g + l) * stride + q].planar_pass = true;
+                            }
+                        }
+                    }
+                    g += 4;
+                }
+            }
+            let own = slots[first * stride..last * stride].chunks_exact(stride);
+            for (k, (own, &alive)) in own.zip(&alive[first..last]).enumerate() {
+                if !alive {
+                    continue;
+                }
+                let listed = own
+                    .iter()
+                    .take_while(|s| s.wall != NO_WALL)
+                    .enumerate()
+                    .filter(|(_, s)| !s.planar_pass)
+                    .map(|(q, _)| (k as u32, (k * stride + q) as u32));
+                lists.rest.extend(listed);
+            }
+            lists.cuts.push((lists.planes.len(), lists.rest.len()));
+        }
     }
 
     /// Rebuild the Verlet lists (pairs, wall slots, gather lists), carrying contact history over.
@@ -1710,6 +1823,9 @@ impl Simulation {
         if self.needs_rebuild {
             self.rebuild();
         }
+        if self.wall_lists.mode != Some((parallel, self.avx2, self.batched)) {
+            self.list_wall_slots(parallel);
+        }
         match self.effects.bits() {
             TABLE => self.force_and_advance::<TABLE>(parallel),
             TABLE_PLANAR => self.force_and_advance::<TABLE_PLANAR>(parallel),
@@ -1773,6 +1889,7 @@ impl Simulation {
             let (onsets, slots) = (&mut self.chunk_onsets, &mut self.wall_slots);
             let (wall_out, wall_detail) = (&mut self.wall_out, &mut self.wall_detail);
             let cut = &self.part_cuts;
+            let wall_lists = &self.wall_lists;
             onsets.clear();
             onsets.resize(pairs.len().div_ceil(PAIR_CHUNK), 0);
             let run = |(t, part): (usize, ForcePart<'_>)| {
@@ -1789,9 +1906,20 @@ impl Simulation {
                 for (slot, chunk) in part.onsets.iter_mut().zip(chunks) {
                     *slot = kernel(chunk);
                 }
+                let lists = &wall_lists;
+                let block = match (lists.cuts.get(t), lists.cuts.get(t + 1)) {
+                    (Some(a), Some(b)) => BlockWalls {
+                        planes: &lists.planes[a.0..b.0],
+                        rest: &lists.rest[a.1..b.1],
+                    },
+                    _ => BlockWalls {
+                        planes: &[],
+                        rest: &[],
+                    },
+                };
                 BATCH_SCRATCH.with_borrow_mut(|b| {
                     let (s, o, d) = (part.slots, part.wall_out, part.wall_detail);
-                    simd::wall::<E>(avx2, &wall_ctx, first_particle, s, o, d, b)
+                    simd::wall::<E>(avx2, &wall_ctx, first_particle, block, s, o, d, b)
                 });
             };
             if parallel {

@@ -519,18 +519,19 @@ mod avx2_forces {
     }
 
     /// The plane-wall slots of a chunk of particles, four particles at a time: for each
-    /// group of four consecutive alive particles and slot column whose four slots hold the
-    /// same plane with Hertz constants, the particles' state is loaded as lanes (no
+    /// group of `planes` (four consecutive alive particles and a slot column whose four
+    /// slots hold the same plane with Hertz constants, listed and marked `planar_pass` by
+    /// `Simulation::list_wall_slots`), the particles' state is loaded as lanes (no
     /// per-contact copies), the plane test, overlap, lever arm and relative velocity are
     /// computed four at a time into the batch, and the batch goes through
     /// [`contact_forces`]; the results are scattered as by [`wall_chunk_batched`]. Every
     /// lane runs the operations of `wall_touch` and `wall_kernel` in their order, so the
-    /// results are bitwise theirs. Marks each slot it took (`planar_pass`), so the batched
-    /// kernel skips it.
+    /// results are bitwise theirs.
     #[target_feature(enable = "avx2")]
     pub(super) unsafe fn plane_slots<const E: u16>(
         c: &WallCtx<'_>,
         first: usize,
+        planes: &[(u32, u32)],
         slots: &mut [WallContact],
         out: &mut [WallOut],
         detail: &mut [WallDetail],
@@ -546,7 +547,6 @@ mod avx2_forces {
         let velocity = &c.shared.velocity[first..first + n_part];
         let omega = &c.shared.omega[first..first + n_part];
         let radius = &c.shared.radius[first..first + n_part];
-        let alive = &c.alive[first..first + n_part];
         let zero = _mm256_setzero_pd();
         let all = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
         let mask3 = _mm256_setr_epi64x(-1, -1, -1, 0);
@@ -556,30 +556,19 @@ mod avx2_forces {
         // the lanes of the last wall seen (slot columns mostly hold the same wall)
         let mut plane: (u32, Option<PlaneLanes>) = (NO_WALL, None);
         b.len = 0;
-        let groups_end = n_part / 4 * 4;
-        let mut g = 0;
-        while g < groups_end {
-            for q in 0..stride {
+        for &(g, q) in planes {
+            let (g, q) = (g as usize, q as usize);
+            if g + 4 > n_part || q >= stride {
+                // not a group of this chunk (cannot happen: the lists are made for it)
+                continue;
+            }
+            {
                 let s0 = g * stride + q;
                 let w = slots[s0].wall;
-                if (0..4).all(|l| slots[s0 + l * stride].wall == NO_WALL) {
-                    // the four particles' lists end here
-                    break;
-                }
                 if w != plane.0 {
                     plane = (w, plane_lanes::<E>(c, w));
                 }
-                let take = plane.1.is_some()
-                    && (0..4).all(|l| {
-                        let s = &slots[s0 + l * stride];
-                        s.wall == w
-                            && alive[g + l]
-                            && c.shared.table[s.k as usize].kind == LawKind::Hertz
-                    });
-                for l in 0..4 {
-                    slots[s0 + l * stride].planar_pass = take;
-                }
-                let Some(pl) = plane.1.as_ref().filter(|_| take) else {
+                let Some(pl) = plane.1.as_ref() else {
                     continue;
                 };
                 // `wall_hit`: d = normal · (x − offset − point), in reach when d < r
@@ -654,15 +643,11 @@ mod avx2_forces {
                     b.len = 0;
                 }
             }
-            g += 4;
         }
         if n_groups > 0 {
             plane_scatter::<E>(c, first, &groups[..n_groups], slots, out, detail, b);
         }
         b.len = 0;
-        for s in &mut slots[groups_end * stride..] {
-            s.planar_pass = false;
-        }
     }
 
     /// Forces of the groups of [`plane_slots`] in the batch, and their scatter (that of
@@ -847,6 +832,7 @@ const _: () = {
     assert!(offset_of!(ContactConst, c_n) == offset_of!(ContactConst, f_el) + 16);
     assert!(offset_of!(ContactConst, ct_ratio) == offset_of!(ContactConst, f_el) + 24);
     assert!(size_of::<WallOut>() == 48 && offset_of!(WallOut, torque) == 24);
+    assert!(size_of::<WallContact>() == 40 && size_of::<PairContact>() == 48);
 };
 
 /// The pairs of one chunk in batches (see [`Batch`]); returns the number of onsets.
@@ -941,90 +927,70 @@ pub(super) fn pair_chunk_batched<const E: u16>(
     onsets
 }
 
-/// The wall slots of one chunk of particles starting at `first`, in batches (see [`Batch`]).
+/// The wall slots of one chunk of particles starting at `first`, in batches (see [`Batch`]):
+/// the plane groups of `lists` (AVX2), then its other slots; no scan of the chunk's slots.
 #[inline(always)]
 pub(super) fn wall_chunk_batched<const E: u16>(
     c: &WallCtx<'_>,
     first: usize,
+    lists: BlockWalls<'_>,
     slots: &mut [WallContact],
     out: &mut [WallOut],
     detail: &mut [WallDetail],
     b: &mut Batch,
 ) {
     let rotation = on::<E>(c.shared.effects, Effect::Rotation);
-    let stride = c.wall_stride;
     let n_slots = slots.len();
-    // with AVX2, plane slots four particles at a time first; they are skipped below
-    let planar = c.shared.avx2;
+    // with AVX2, the plane groups four particles at a time first
     #[cfg(target_arch = "x86_64")]
-    if planar {
+    if c.shared.avx2 {
         // SAFETY: `avx2` is set only when the CPU reported AVX2.
-        unsafe { avx2_forces::plane_slots::<E>(c, first, slots, out, detail, b) };
+        unsafe { avx2_forces::plane_slots::<E>(c, first, lists.planes, slots, out, detail, b) };
     }
     let (out, detail) = (&mut out[..n_slots], &mut detail[..n_slots]);
     let mut next = 0usize;
-    let mut particle = first;
-    while next < n_slots {
-        // ---- find the slots in contact, particle by particle
+    while next < lists.rest.len() {
+        // ---- the listed slots, up to a batch of them in contact
         b.len = 0;
         let mut pending = false;
-        while next < n_slots && b.len + stride <= BATCH {
-            let first_slot = next;
-            next += stride;
-            let i = particle;
-            particle += 1;
-            if !c.alive[i] {
+        while next < lists.rest.len() && b.len < BATCH {
+            let (i, q) = lists.rest[next];
+            next += 1;
+            let (i, q) = (first + i as usize, q as usize);
+            let Some(s) = slots.get_mut(q) else {
                 continue;
-            }
-            let own = &slots[first_slot..first_slot + stride];
-            if planar
-                && own
-                    .iter()
-                    .take_while(|s| s.wall != NO_WALL)
-                    .all(|s| s.planar_pass)
-            {
-                continue;
-            }
+            };
             let (x, v, w) = (
                 c.shared.position[i],
                 c.shared.velocity[i],
                 c.shared.omega[i],
             );
             let r = c.shared.radius[i];
-            for q in first_slot..first_slot + stride {
-                let s = &mut slots[q];
-                if s.wall == NO_WALL {
-                    break;
-                }
-                if planar && s.planar_pass {
-                    continue;
-                }
-                let Some(WallTouch {
-                    point,
-                    n,
-                    overlap,
-                    arm,
-                    wall_v,
-                }) = wall_touch::<E>(s, x, r, c)
-                else {
-                    continue;
-                };
-                let k = b.len;
-                b.len += 1;
-                b.index[k] = q as u32;
-                b.n.set(k, n);
-                b.overlap[k] = overlap;
-                b.arm[k] = arm;
-                b.v_rel.set(k, v - wall_v);
-                if rotation {
-                    b.spin.set(k, arm * w);
-                }
-                b.history.set(k, s.history);
-                pending |= b.set_constants(k, &c.shared.table[s.k as usize], &c.shared);
-                if !s.active || c.shared.detail {
-                    // recorded at onset and on detail steps
-                    detail[q].point = point;
-                }
+            let Some(WallTouch {
+                point,
+                n,
+                overlap,
+                arm,
+                wall_v,
+            }) = wall_touch::<E>(s, x, r, c)
+            else {
+                continue;
+            };
+            let k = b.len;
+            b.len += 1;
+            b.index[k] = q as u32;
+            b.n.set(k, n);
+            b.overlap[k] = overlap;
+            b.arm[k] = arm;
+            b.v_rel.set(k, v - wall_v);
+            if rotation {
+                b.spin.set(k, arm * w);
+            }
+            b.history.set(k, s.history);
+            pending |= b.set_constants(k, &c.shared.table[s.k as usize], &c.shared);
+            if !s.active || c.shared.detail {
+                // recorded at onset and on detail steps
+                detail[q].point = point;
             }
         }
         // ---- laws, forces
