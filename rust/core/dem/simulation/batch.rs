@@ -858,6 +858,10 @@ pub(super) fn pair_chunk_batched<const E: u16>(
         &mut detail[..len],
         &konst[..len],
     );
+    // the particle arrays cut to the positions' length: a pair that passed the reach test
+    // has i, j below it, so reading its velocities, spins and radii needs no further test
+    let n = c.position.len();
+    let (velocity, omega, radius) = (&c.velocity[..n], &c.omega[..n], &c.radius[..n]);
     let mut next = 0usize;
     while next < len {
         // ---- find the pairs in contact (and end the contacts that stopped)
@@ -878,12 +882,12 @@ pub(super) fn pair_chunk_batched<const E: u16>(
             b.n.set(k, d);
             b.overlap[k] = dist2;
             b.r_sum[k] = r_sum;
-            b.v_rel.set(k, c.velocity[i] - c.velocity[j]);
+            b.v_rel.set(k, velocity[i] - velocity[j]);
             if rotation {
-                b.r_i[k] = c.radius[i];
-                b.r_j[k] = c.radius[j];
-                b.omega_i.set(k, c.omega[i]);
-                b.omega_j.set(k, c.omega[j]);
+                b.r_i[k] = radius[i];
+                b.r_j[k] = radius[j];
+                b.omega_i.set(k, omega[i]);
+                b.omega_j.set(k, omega[j]);
             }
             b.history.set(k, p.history);
             if hertz {
