@@ -1906,11 +1906,10 @@ impl Simulation {
                 for (slot, chunk) in part.onsets.iter_mut().zip(chunks) {
                     *slot = kernel(chunk);
                 }
-                let lists = &wall_lists;
-                let block = match (lists.cuts.get(t), lists.cuts.get(t + 1)) {
+                let block = match (wall_lists.cuts.get(t), wall_lists.cuts.get(t + 1)) {
                     (Some(a), Some(b)) => BlockWalls {
-                        planes: &lists.planes[a.0..b.0],
-                        rest: &lists.rest[a.1..b.1],
+                        planes: &wall_lists.planes[a.0..b.0],
+                        rest: &wall_lists.rest[a.1..b.1],
                     },
                     _ => BlockWalls {
                         planes: &[],

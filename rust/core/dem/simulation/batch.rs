@@ -562,86 +562,84 @@ mod avx2_forces {
                 // not a group of this chunk (cannot happen: the lists are made for it)
                 continue;
             }
-            {
-                let s0 = g * stride + q;
-                let w = slots[s0].wall;
-                if w != plane.0 {
-                    plane = (w, plane_lanes::<E>(c, w));
+            let s0 = g * stride + q;
+            let w = slots[s0].wall;
+            if w != plane.0 {
+                plane = (w, plane_lanes::<E>(c, w));
+            }
+            let Some(pl) = plane.1.as_ref() else {
+                continue;
+            };
+            // `wall_hit`: d = normal · (x − offset − point), in reach when d < r
+            let mut x = load_aos4(position.as_ptr().add(g));
+            if moving {
+                x = sub(x, pl.offset);
+            }
+            let d = dot(pl.normal, sub(x, pl.point));
+            let r = _mm256_loadu_pd(radius.as_ptr().add(g));
+            let reach = _mm256_cmp_pd::<_CMP_LT_OQ>(d, r);
+            let m = _mm256_movemask_pd(reach) as u32;
+            if m != 0b1111 {
+                // out of reach: `wall_touch`'s reset
+                for l in 0..4 {
+                    if m >> l & 1 == 0 {
+                        end_wall_contact(&mut slots[s0 + l * stride]);
+                    }
                 }
-                let Some(pl) = plane.1.as_ref() else {
+                if m == 0 {
                     continue;
-                };
-                // `wall_hit`: d = normal · (x − offset − point), in reach when d < r
-                let mut x = load_aos4(position.as_ptr().add(g));
-                if moving {
-                    x = sub(x, pl.offset);
                 }
-                let d = dot(pl.normal, sub(x, pl.point));
-                let r = _mm256_loadu_pd(radius.as_ptr().add(g));
-                let reach = _mm256_cmp_pd::<_CMP_LT_OQ>(d, r);
-                let m = _mm256_movemask_pd(reach) as u32;
-                if m != 0b1111 {
-                    // out of reach: `wall_touch`'s reset
-                    for l in 0..4 {
-                        if m >> l & 1 == 0 {
-                            end_wall_contact(&mut slots[s0 + l * stride]);
-                        }
-                    }
-                    if m == 0 {
-                        continue;
-                    }
-                }
-                let k = 4 * n_groups;
-                let overlap = _mm256_sub_pd(r, d);
-                let arm = _mm256_max_pd(d, zero);
-                store(&mut b.n, k, pl.n);
-                st(&mut b.overlap, k, overlap);
-                st(&mut b.arm, k, arm);
-                store(
-                    &mut b.v_rel,
-                    k,
-                    sub(load_aos4(velocity.as_ptr().add(g)), pl.wall_v),
-                );
-                if rotation {
-                    store(&mut b.spin, k, scale(arm, load_aos4(omega.as_ptr().add(g))));
-                }
-                let sp = |l: usize| &slots[s0 + l * stride];
-                let hrow = |l: usize| _mm256_maskload_pd(&sp(l).history.x, mask3);
-                let [hx, hy, hz, _] = transpose(hrow(0), hrow(1), hrow(2), hrow(3));
-                store(
-                    &mut b.history,
-                    k,
-                    V4 {
-                        x: hx,
-                        y: hy,
-                        z: hz,
-                    },
-                );
-                // f_el, k_t, c_n, c_t/c_n are 32 contiguous bytes of a `ContactConst`
-                let kp = |l: usize| &c.shared.table[sp(l).k as usize];
-                let krow = |l: usize| _mm256_loadu_pd(&kp(l).f_el);
-                let [f_el, k_t, c_n, ct_ratio] = transpose(krow(0), krow(1), krow(2), krow(3));
-                st(&mut b.f_el, k, f_el);
-                st(&mut b.k_t, k, k_t);
-                st(&mut b.c_n, k, c_n);
-                st(&mut b.ct_ratio, k, ct_ratio);
-                st(
-                    &mut b.mu,
-                    k,
-                    _mm256_setr_pd(kp(0).mu, kp(1).mu, kp(2).mu, kp(3).mu),
-                );
-                _mm256_storeu_si256(
-                    b.hertz.as_mut_ptr().add(k) as *mut __m256i,
-                    _mm256_castpd_si256(all),
-                );
-                groups[n_groups] = (g as u32, q as u32, m);
-                n_groups += 1;
-                b.len = 4 * n_groups;
-                if n_groups == BATCH / 4 {
-                    plane_scatter::<E>(c, first, &groups[..n_groups], slots, out, detail, b);
-                    n_groups = 0;
-                    b.len = 0;
-                }
+            }
+            let k = 4 * n_groups;
+            let overlap = _mm256_sub_pd(r, d);
+            let arm = _mm256_max_pd(d, zero);
+            store(&mut b.n, k, pl.n);
+            st(&mut b.overlap, k, overlap);
+            st(&mut b.arm, k, arm);
+            store(
+                &mut b.v_rel,
+                k,
+                sub(load_aos4(velocity.as_ptr().add(g)), pl.wall_v),
+            );
+            if rotation {
+                store(&mut b.spin, k, scale(arm, load_aos4(omega.as_ptr().add(g))));
+            }
+            let sp = |l: usize| &slots[s0 + l * stride];
+            let hrow = |l: usize| _mm256_maskload_pd(&sp(l).history.x, mask3);
+            let [hx, hy, hz, _] = transpose(hrow(0), hrow(1), hrow(2), hrow(3));
+            store(
+                &mut b.history,
+                k,
+                V4 {
+                    x: hx,
+                    y: hy,
+                    z: hz,
+                },
+            );
+            // f_el, k_t, c_n, c_t/c_n are 32 contiguous bytes of a `ContactConst`
+            let kp = |l: usize| &c.shared.table[sp(l).k as usize];
+            let krow = |l: usize| _mm256_loadu_pd(&kp(l).f_el);
+            let [f_el, k_t, c_n, ct_ratio] = transpose(krow(0), krow(1), krow(2), krow(3));
+            st(&mut b.f_el, k, f_el);
+            st(&mut b.k_t, k, k_t);
+            st(&mut b.c_n, k, c_n);
+            st(&mut b.ct_ratio, k, ct_ratio);
+            st(
+                &mut b.mu,
+                k,
+                _mm256_setr_pd(kp(0).mu, kp(1).mu, kp(2).mu, kp(3).mu),
+            );
+            _mm256_storeu_si256(
+                b.hertz.as_mut_ptr().add(k) as *mut __m256i,
+                _mm256_castpd_si256(all),
+            );
+            groups[n_groups] = (g as u32, q as u32, m);
+            n_groups += 1;
+            b.len = 4 * n_groups;
+            if n_groups == BATCH / 4 {
+                plane_scatter::<E>(c, first, &groups[..n_groups], slots, out, detail, b);
+                n_groups = 0;
+                b.len = 0;
             }
         }
         if n_groups > 0 {
