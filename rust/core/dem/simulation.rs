@@ -308,6 +308,8 @@ pub struct Simulation {
     batched: bool,
     /// See [`PairCtx::pairs_hertz`] (set with the contact constants).
     pairs_hertz: bool,
+    /// See [`PairCtx::pairs_uniform`] (set with the contact constants).
+    pairs_uniform: Option<(u32, f64)>,
     pub(crate) record_every: u64,
     pub(crate) record_onsets: bool,
     /// Outlet plane (point, unit normal towards the kept side).
@@ -417,6 +419,10 @@ struct PairCtx<'a> {
     /// Every pair follows the Hertz law ([`LawKind::Hertz`]), so with AVX2 the batched pair
     /// kernel copies the constants without testing the law of each.
     pairs_hertz: bool,
+    /// Every pair indexes the same Hertz entry of `table` and every particle has the same
+    /// radius (m): (entry, radius). The batched pair kernel then writes the constants and
+    /// radii into its batch once per chunk instead of once per contact.
+    pairs_uniform: Option<(u32, f64)>,
 }
 
 /// Read-only context of the wall kernels (run in the force phase, next to the pairs).
@@ -514,6 +520,9 @@ struct WallLists {
     /// Block b's groups are `planes[cuts[b].0..cuts[b + 1].0]`, its slots
     /// `rest[cuts[b].1..cuts[b + 1].1]`.
     cuts: Vec<(usize, usize)>,
+    /// The entry of the contact table every slot of every group indexes, if they all index
+    /// one: the plane pass then writes the constants into its batch once, not per group.
+    plane_const: Option<u32>,
     /// The (parallel, AVX2, batched) mode the lists were made for; `None` once the neighbour
     /// lists change.
     mode: Option<(bool, bool, bool)>,
@@ -524,6 +533,8 @@ struct WallLists {
 struct BlockWalls<'a> {
     planes: &'a [(u32, u32)],
     rest: &'a [(u32, u32)],
+    /// [`WallLists::plane_const`].
+    plane_const: Option<u32>,
 }
 
 /// Runs `run` on every part, the first on the calling thread, the others offered to the
@@ -634,11 +645,11 @@ fn pair_in_reach(
     active: &mut bool,
     out: &mut PairOut,
     position: &[Vec3],
+    reach2: f64,
 ) -> Option<(Vec3, f64)> {
     let d = position[p.j as usize] - position[p.i as usize];
     let dist2 = d.length_squared();
-    let r_sum = p.r_sum;
-    if dist2 >= r_sum * r_sum || dist2 == 0.0 {
+    if dist2 >= reach2 || dist2 == 0.0 {
         // an inactive pair has nothing to reset: its output slot already reads "no contact"
         // (onset is only ever set together with active)
         if *active {
@@ -734,7 +745,7 @@ fn pair_kernel<const E: u16>(
     rolling_torque: &mut Vec3,
     c: &PairCtx<'_>,
 ) -> bool {
-    let Some((d, dist2)) = pair_in_reach(p, active, out, c.position) else {
+    let Some((d, dist2)) = pair_in_reach(p, active, out, c.position, p.r_sum * p.r_sum) else {
         return false;
     };
     let (i, j) = (p.i as usize, p.j as usize);
@@ -822,7 +833,12 @@ fn pair_chunk<const E: u16>(
     batch: &mut Batch,
 ) -> u32 {
     if c.batched && !on::<E>(c.effects, Effect::RollingResistance) {
-        return pair_chunk_batched::<E>(chunk, active, out, detail, konst, c, batch);
+        return match c.pairs_uniform {
+            Some(_) if c.avx2 => {
+                pair_chunk_batched::<E, true>(chunk, active, out, detail, konst, c, batch)
+            }
+            _ => pair_chunk_batched::<E, false>(chunk, active, out, detail, konst, c, batch),
+        };
     }
     let mut onsets = 0u32;
     for (((((p, a), o), d), r), k) in chunk
@@ -1399,6 +1415,7 @@ impl Simulation {
             avx2: cpu_has_avx2(),
             batched: true,
             pairs_hertz: false,
+            pairs_uniform: None,
             record_every: scene.record_every,
             record_onsets: scene.record_onsets,
             removal_plane: scene.removal_plane.map(|(p, n)| (p, n / n.length())),
@@ -1594,6 +1611,18 @@ impl Simulation {
             .pair_const
             .iter()
             .all(|&k| table[k as usize].kind == LawKind::Hertz);
+        let first_k = self.pair_const.first().copied();
+        let r0 = self.radius.first().copied();
+        self.pairs_uniform = match (first_k, r0) {
+            (Some(k0), Some(r0))
+                if self.pairs_hertz
+                    && self.pair_const.iter().all(|&k| k == k0)
+                    && self.radius.iter().all(|&r| r.to_bits() == r0.to_bits()) =>
+            {
+                Some((k0, r0))
+            }
+            _ => None,
+        };
     }
 
     /// The [`WallLists`] for the step's mode: per block of the force phase (`parallel`: the
@@ -1612,6 +1641,8 @@ impl Simulation {
         lists.cuts.clear();
         lists.cuts.push((0, 0));
         lists.mode = Some((parallel, self.avx2, self.batched));
+        // Some(None) until a group is taken, then Some(Some(k)) while all share entry k
+        let mut plane_const: Option<Option<u32>> = Some(None);
         let mut ends = vec![0];
         if parallel {
             ends.extend(self.part_cuts.iter().map(|c| c.0));
@@ -1648,7 +1679,13 @@ impl Simulation {
                         if take {
                             lists.planes.push(((g - first) as u32, q as u32));
                             for l in 0..4 {
-                                slots[(g + l) * stride + q].planar_pass = true;
+                                let s = &mut slots[(g + l) * stride + q];
+                                s.planar_pass = true;
+                                plane_const = match plane_const {
+                                    Some(None) => Some(Some(s.k)),
+                                    Some(Some(k)) if k == s.k => Some(Some(k)),
+                                    _ => None,
+                                };
                             }
                         }
                     }
@@ -1670,6 +1707,7 @@ impl Simulation {
             }
             lists.cuts.push((lists.planes.len(), lists.rest.len()));
         }
+        lists.plane_const = plane_const.flatten();
     }
 
     /// Rebuild the Verlet lists (pairs, wall slots, gather lists), carrying contact history over.
@@ -1856,6 +1894,7 @@ impl Simulation {
                 avx2,
                 batched: self.batched,
                 pairs_hertz: self.pairs_hertz,
+                pairs_uniform: self.pairs_uniform,
             };
             let wall_ctx = WallCtx {
                 shared: pair_ctx,
@@ -1910,10 +1949,12 @@ impl Simulation {
                     (Some(a), Some(b)) => BlockWalls {
                         planes: &wall_lists.planes[a.0..b.0],
                         rest: &wall_lists.rest[a.1..b.1],
+                        plane_const: wall_lists.plane_const,
                     },
                     _ => BlockWalls {
                         planes: &[],
                         rest: &[],
+                        plane_const: None,
                     },
                 };
                 BATCH_SCRATCH.with_borrow_mut(|b| {
@@ -2249,6 +2290,14 @@ impl Simulation {
             .iter()
             .filter(|s| s.wall != NO_WALL && s.planar_pass)
             .count()
+    }
+
+    /// Whether the batched AVX2 pair kernel takes the uniform path: every pair indexes one
+    /// Hertz law entry and every sphere has one radius, so the constants and radii are
+    /// written into the batch once per chunk (a diagnostic; results are bitwise those of the
+    /// general path).
+    pub fn uniform_pairs(&self) -> bool {
+        self.avx2 && self.batched && self.pairs_uniform.is_some()
     }
 
     /// Whether contacts are evaluated in batches (see [`Simulation::set_batched`]).

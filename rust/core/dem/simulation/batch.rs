@@ -146,6 +146,26 @@ impl Batch {
         self.mu[k] = konst.mu;
     }
 
+    /// Every lane's Hertz constants set to `konst` (see [`WallLists::plane_const`]).
+    #[inline(always)]
+    fn fill_constants(&mut self, konst: &ContactConst) {
+        for k in 0..BATCH {
+            self.copy_constants(k, konst, true);
+        }
+    }
+
+    /// Every lane's constants and radii set to those of a uniform pair list (see
+    /// [`PairCtx::pairs_uniform`]): Hertz constants `konst`, radii `r` (r_sum = r + r).
+    #[inline(always)]
+    fn fill_uniform(&mut self, konst: &ContactConst, r: f64) {
+        self.fill_constants(konst);
+        for k in 0..BATCH {
+            self.r_sum[k] = r + r;
+            self.r_i[k] = r;
+            self.r_j[k] = r;
+        }
+    }
+
     /// Law values of the contacts whose law is pending (see [`Batch::set_constants`]).
     #[inline(always)]
     fn set_laws<const E: u16>(&mut self, c: &PairCtx<'_>, konst: impl Fn(usize) -> ContactConst) {
@@ -528,10 +548,12 @@ mod avx2_forces {
     /// lane runs the operations of `wall_touch` and `wall_kernel` in their order, so the
     /// results are bitwise theirs.
     #[target_feature(enable = "avx2")]
+    #[allow(clippy::too_many_arguments)]
     pub(super) unsafe fn plane_slots<const E: u16>(
         c: &WallCtx<'_>,
         first: usize,
         planes: &[(u32, u32)],
+        plane_const: Option<u32>,
         slots: &mut [WallContact],
         out: &mut [WallOut],
         detail: &mut [WallDetail],
@@ -556,6 +578,14 @@ mod avx2_forces {
         // the lanes of the last wall seen (slot columns mostly hold the same wall)
         let mut plane: (u32, Option<PlaneLanes>) = (NO_WALL, None);
         b.len = 0;
+        // one entry for every group: its constants written into the batch here, once
+        let uniform = match plane_const.and_then(|k| c.shared.table.get(k as usize)) {
+            Some(konst) => {
+                b.fill_constants(konst);
+                true
+            }
+            None => false,
+        };
         for &(g, q) in planes {
             let (g, q) = (g as usize, q as usize);
             if g + 4 > n_part || q >= stride {
@@ -616,23 +646,9 @@ mod avx2_forces {
                     z: hz,
                 },
             );
-            // f_el, k_t, c_n, c_t/c_n are 32 contiguous bytes of a `ContactConst`
-            let kp = |l: usize| &c.shared.table[sp(l).k as usize];
-            let krow = |l: usize| _mm256_loadu_pd(&kp(l).f_el);
-            let [f_el, k_t, c_n, ct_ratio] = transpose(krow(0), krow(1), krow(2), krow(3));
-            st(&mut b.f_el, k, f_el);
-            st(&mut b.k_t, k, k_t);
-            st(&mut b.c_n, k, c_n);
-            st(&mut b.ct_ratio, k, ct_ratio);
-            st(
-                &mut b.mu,
-                k,
-                _mm256_setr_pd(kp(0).mu, kp(1).mu, kp(2).mu, kp(3).mu),
-            );
-            _mm256_storeu_si256(
-                b.hertz.as_mut_ptr().add(k) as *mut __m256i,
-                _mm256_castpd_si256(all),
-            );
+            if !uniform {
+                plane_constants(c, sp, k, b, all);
+            }
             groups[n_groups] = (g as u32, q as u32, m);
             n_groups += 1;
             b.len = 4 * n_groups;
@@ -646,6 +662,35 @@ mod avx2_forces {
             plane_scatter::<E>(c, first, &groups[..n_groups], slots, out, detail, b);
         }
         b.len = 0;
+    }
+
+    /// The constants of one group of [`plane_slots`] (slot of lane l: `sp(l)`) into lanes
+    /// `k..k + 4` of the batch, Hertz mask `all` set.
+    #[inline(always)]
+    unsafe fn plane_constants<'s>(
+        c: &WallCtx<'_>,
+        sp: impl Fn(usize) -> &'s WallContact,
+        k: usize,
+        b: &mut Batch,
+        all: __m256d,
+    ) {
+        // f_el, k_t, c_n, c_t/c_n are 32 contiguous bytes of a `ContactConst`
+        let kp = |l: usize| &c.shared.table[sp(l).k as usize];
+        let krow = |l: usize| _mm256_loadu_pd(&kp(l).f_el);
+        let [f_el, k_t, c_n, ct_ratio] = transpose(krow(0), krow(1), krow(2), krow(3));
+        st(&mut b.f_el, k, f_el);
+        st(&mut b.k_t, k, k_t);
+        st(&mut b.c_n, k, c_n);
+        st(&mut b.ct_ratio, k, ct_ratio);
+        st(
+            &mut b.mu,
+            k,
+            _mm256_setr_pd(kp(0).mu, kp(1).mu, kp(2).mu, kp(3).mu),
+        );
+        _mm256_storeu_si256(
+            b.hertz.as_mut_ptr().add(k) as *mut __m256i,
+            _mm256_castpd_si256(all),
+        );
     }
 
     /// Forces of the groups of [`plane_slots`] in the batch, and their scatter (that of
@@ -833,10 +878,12 @@ const _: () = {
     assert!(size_of::<WallContact>() == 40 && size_of::<PairContact>() == 48);
 };
 
-/// The pairs of one chunk in batches (see [`Batch`]); returns the number of onsets.
+/// The pairs of one chunk in batches (see [`Batch`]); returns the number of onsets. `U`:
+/// the pairs are uniform ([`PairCtx::pairs_uniform`], with AVX2), so their constants and
+/// radii are written into the batch once and their reach is one number.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-pub(super) fn pair_chunk_batched<const E: u16>(
+pub(super) fn pair_chunk_batched<const E: u16, const U: bool>(
     chunk: &mut [PairContact],
     active: &mut [bool],
     out: &mut [PairOut],
@@ -848,6 +895,14 @@ pub(super) fn pair_chunk_batched<const E: u16>(
     let rotation = on::<E>(c.effects, Effect::Rotation);
     // every pair's law is evaluated by the AVX2 force pass: no per-pair test of the law
     let hertz = c.avx2 && c.pairs_hertz;
+    // one law entry and one radius for every pair: written into the batch once per chunk
+    let mut uniform_reach2 = 0.0;
+    if U {
+        if let Some((k, r)) = c.pairs_uniform {
+            b.fill_uniform(&c.table[k as usize], r);
+            uniform_reach2 = (r + r) * (r + r);
+        }
+    }
     let mut onsets = 0u32;
     let len = chunk.len();
     let (active, out, detail, konst) = (
@@ -869,29 +924,34 @@ pub(super) fn pair_chunk_batched<const E: u16>(
             let e = next;
             next += 1;
             let p = &mut chunk[e];
-            let Some((d, dist2)) = pair_in_reach(p, &mut active[e], &mut out[e], c.position) else {
+            let reach2 = if U { uniform_reach2 } else { p.r_sum * p.r_sum };
+            let Some((d, dist2)) = pair_in_reach(p, &mut active[e], &mut out[e], c.position, reach2)
+            else {
                 continue;
             };
             let (i, j) = (p.i as usize, p.j as usize);
-            let r_sum = p.r_sum;
             let k = b.len;
             b.len += 1;
             b.index[k] = e as u32;
             b.n.set(k, d);
             b.overlap[k] = dist2;
-            b.r_sum[k] = r_sum;
             b.v_rel.set(k, velocity[i] - velocity[j]);
             if rotation {
-                b.r_i[k] = radius[i];
-                b.r_j[k] = radius[j];
                 b.omega_i.set(k, omega[i]);
                 b.omega_j.set(k, omega[j]);
             }
             b.history.set(k, p.history);
-            if hertz {
-                b.copy_constants(k, &c.table[konst[e] as usize], true);
-            } else {
-                pending |= b.set_constants(k, &c.table[konst[e] as usize], c);
+            if !U {
+                b.r_sum[k] = p.r_sum;
+                if rotation {
+                    b.r_i[k] = radius[i];
+                    b.r_j[k] = radius[j];
+                }
+                if hertz {
+                    b.copy_constants(k, &c.table[konst[e] as usize], true);
+                } else {
+                    pending |= b.set_constants(k, &c.table[konst[e] as usize], c);
+                }
             }
         }
         // ---- overlaps and normals, laws, forces
@@ -947,7 +1007,7 @@ pub(super) fn wall_chunk_batched<const E: u16>(
     #[cfg(target_arch = "x86_64")]
     if c.shared.avx2 {
         // SAFETY: `avx2` is set only when the CPU reported AVX2.
-        unsafe { avx2_forces::plane_slots::<E>(c, first, lists.planes, slots, out, detail, b) };
+        unsafe { avx2_forces::plane_slots::<E>(c, first, lists.planes, lists.plane_const, slots, out, detail, b) };
     }
     let (out, detail) = (&mut out[..n_slots], &mut detail[..n_slots]);
     let mut next = 0usize;
