@@ -539,7 +539,7 @@ mod avx2_forces {
     }
 
     /// The plane-wall slots of a chunk of particles, four particles at a time: for each
-    /// group of `planes` (four consecutive alive particles and a slot column whose four
+    /// group of `lists.planes` (four consecutive alive particles and a slot column whose four
     /// slots hold the same plane with Hertz constants, listed and marked `planar_pass` by
     /// `Simulation::list_wall_slots`), the particles' state is loaded as lanes (no
     /// per-contact copies), the plane test, overlap, lever arm and relative velocity are
@@ -548,12 +548,10 @@ mod avx2_forces {
     /// lane runs the operations of `wall_touch` and `wall_kernel` in their order, so the
     /// results are bitwise theirs.
     #[target_feature(enable = "avx2")]
-    #[allow(clippy::too_many_arguments)]
     pub(super) unsafe fn plane_slots<const E: u16>(
         c: &WallCtx<'_>,
         first: usize,
-        planes: &[(u32, u32)],
-        plane_const: Option<u32>,
+        lists: BlockWalls<'_>,
         slots: &mut [WallContact],
         out: &mut [WallOut],
         detail: &mut [WallDetail],
@@ -579,14 +577,17 @@ mod avx2_forces {
         let mut plane: (u32, Option<PlaneLanes>) = (NO_WALL, None);
         b.len = 0;
         // one entry for every group: its constants written into the batch here, once
-        let uniform = match plane_const.and_then(|k| c.shared.table.get(k as usize)) {
+        let uniform = match lists
+            .plane_const
+            .and_then(|k| c.shared.table.get(k as usize))
+        {
             Some(konst) => {
                 b.fill_constants(konst);
                 true
             }
             None => false,
         };
-        for &(g, q) in planes {
+        for &(g, q) in lists.planes {
             let (g, q) = (g as usize, q as usize);
             if g + 4 > n_part || q >= stride {
                 // not a group of this chunk (cannot happen: the lists are made for it)
@@ -925,7 +926,8 @@ pub(super) fn pair_chunk_batched<const E: u16, const U: bool>(
             next += 1;
             let p = &mut chunk[e];
             let reach2 = if U { uniform_reach2 } else { p.r_sum * p.r_sum };
-            let Some((d, dist2)) = pair_in_reach(p, &mut active[e], &mut out[e], c.position, reach2)
+            let Some((d, dist2)) =
+                pair_in_reach(p, &mut active[e], &mut out[e], c.position, reach2)
             else {
                 continue;
             };
@@ -1007,7 +1009,7 @@ pub(super) fn wall_chunk_batched<const E: u16>(
     #[cfg(target_arch = "x86_64")]
     if c.shared.avx2 {
         // SAFETY: `avx2` is set only when the CPU reported AVX2.
-        unsafe { avx2_forces::plane_slots::<E>(c, first, lists.planes, lists.plane_const, slots, out, detail, b) };
+        unsafe { avx2_forces::plane_slots::<E>(c, first, lists, slots, out, detail, b) };
     }
     let (out, detail) = (&mut out[..n_slots], &mut detail[..n_slots]);
     let mut next = 0usize;
