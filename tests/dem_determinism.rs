@@ -5,7 +5,9 @@
 
 use demfem::contact::reissner_stiffness;
 use demfem::dem::table::{anchor_scene, TableStart};
-use demfem::dem::{ContactModel, Effect, Simulation};
+use demfem::dem::{
+    ContactModel, Effect, EffectSet, Material, ParticleInit, Partner, Scene, Simulation,
+};
 use demfem::geometry::{Vec3, WallMotion};
 
 fn bits(sim: &Simulation) -> Vec<u64> {
@@ -253,6 +255,12 @@ fn batched_and_one_at_a_time_kernels_are_bitwise_identical() {
                 assert_eq!(planes, 0, "{name}, AVX2 {avx2}");
             }
             assert_eq!(reference.plane_pass_slots(), 0);
+            // the batched kernel skips pairs that cannot touch yet; the reference tests all
+            assert!(
+                batched.sleeping_pairs() > 20,
+                "{name}: {} pairs skipped",
+                batched.sleeping_pairs()
+            );
             assert!(reference.contacts().len() > 500, "{name}: too few contacts");
             assert_eq!(reference.contacts(), batched.contacts(), "{name}");
             assert_eq!(reference.onsets(), batched.onsets(), "{name}");
@@ -292,4 +300,68 @@ fn restart_from_checkpoint_is_bitwise_identical() {
     let mut other = Simulation::new(&other_scene).unwrap();
     assert!(other.load_checkpoint(&path).is_err());
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The batched pair kernel skips a pair out of contact while neither sphere can have moved
+/// half its gap (the travel bound, `Simulation::sleeping_pairs`). A 5 m/s sphere fired down
+/// a row of resting spheres, with a skin wide enough that every gap of the row is a
+/// candidate pair from the first step, hits each sphere at the same step as the one-at-a-time
+/// kernels (which test every pair every step), and the runs end bitwise equal; the spheres
+/// that were at rest when their pairs went to sleep are woken by the travel of the fast one.
+#[test]
+fn skipped_pairs_touch_at_the_same_step_as_tested_pairs() {
+    let build = || {
+        let r = 8e-3;
+        // gaps 14, 1, 1.5 and 3 mm along x, off-centre in y (oblique hits), and one sphere
+        // 60 mm to the side that nothing reaches
+        let position = vec![
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(0.030, 1e-3, 0.0),
+            Vec3::new(0.047, -1e-3, 0.5e-3),
+            Vec3::new(0.0645, 0.0, 0.0),
+            Vec3::new(0.0835, 2e-3, 0.0),
+            Vec3::new(0.047, 0.060, 0.0),
+        ];
+        let n = position.len();
+        let mut p = ParticleInit::at_rest(position, vec![r; n]);
+        p.velocity[0] = Vec3::new(5.0, 0.0, 0.0);
+        let glass = Material::new(1e9, 0.22, 2230.0, 0.2, 0.9, 0.0);
+        let effects = EffectSet::of(&[Effect::Friction, Effect::Rotation, Effect::Damping]);
+        let mut scene = Scene::new(p, vec![glass], vec![], effects);
+        scene.gravity = Vec3::ZERO;
+        scene.expected_max_speed = 5.0;
+        scene.skin = Some(0.02);
+        scene.record_onsets = true;
+        Simulation::new(&scene).unwrap()
+    };
+    let mut reference = build();
+    reference.set_batched(false);
+    let mut batched = build();
+    let mut slept = 0;
+    for _ in 0..40 {
+        reference.step(100).unwrap();
+        batched.step(100).unwrap();
+        slept = slept.max(batched.sleeping_pairs());
+        assert_eq!(
+            bits(&reference),
+            bits(&batched),
+            "at step {}",
+            batched.steps()
+        );
+    }
+    assert_eq!(reference.onsets(), batched.onsets());
+    assert!(slept >= 5, "at most {slept} pairs skipped");
+    // every sphere of the row was hit, the one to the side never
+    let hit: Vec<u32> = batched
+        .onsets()
+        .iter()
+        .filter_map(|o| match o.partner {
+            Partner::Particle(j) => Some(j),
+            Partner::Wall(_) => None,
+        })
+        .collect();
+    for j in 1..5 {
+        assert!(hit.contains(&j), "sphere {j} never hit: {hit:?}");
+    }
+    assert!(!hit.contains(&5));
 }

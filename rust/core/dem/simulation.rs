@@ -67,14 +67,17 @@ use batch::{pair_chunk_batched, wall_chunk_batched, Batch, BATCH, BATCH_SCRATCH}
 pub const PARALLEL_MIN_PARTICLES: usize = 256;
 /// Pairs per kernel call (onsets are counted per chunk, to find them without a full scan).
 const PAIR_CHUNK: usize = 256;
+/// The batched pair kernel skips a pair out of contact only while it cannot touch for at
+/// least this many steps at the last step's speed (see [`wake_travel`]).
+const SKIP_STEPS: f64 = 8.0;
 /// Granularity of the threads' particle blocks.
 const PARTICLE_CHUNK: usize = 64;
 const NO_WALL: u32 = u32::MAX;
 
 /// A candidate particle pair of the Verlet list with the contact state the step carries: 48
 /// bytes, what the pair phase reads for every candidate (i, j, r_i + r_j) first. Whether the
-/// pair is in contact is kept apart, in [`Simulation::pair_active`] (one byte per pair, so the
-/// gather's test of every candidate stays in L1). What the step produces goes to [`PairOut`] (read by the gather) and, on
+/// pair is in contact is kept apart, in [`Simulation::pair_active`] (one byte per pair; the
+/// gather visits only the pairs in contact, from lists of their own). What the step produces goes to [`PairOut`] (read by the gather) and, on
 /// the last step of a [`Simulation::step`] call, to [`PairDetail`] (read only by the records),
 /// so a step streams as few cache lines as it can.
 #[derive(Debug, Clone, Copy, Default)]
@@ -324,6 +327,21 @@ pub struct Simulation {
     pub(crate) pairs: Vec<PairContact>,
     /// Whether each pair was in contact at the last force evaluation.
     pub(crate) pair_active: Vec<bool>,
+    /// Until when each pair out of contact cannot touch, in units of [`Simulation::travel`]
+    /// (m): a pair last found a gap g apart when the travel was D cannot touch while the
+    /// travel is below D + g/2 (less a rounding margin), because neither of its particles
+    /// has moved further than the travel since. The batched pair kernel skips it until then
+    /// (exactly: a pair out of reach and not active does nothing); −∞ for a pair to test.
+    /// Reset with the lists; not checkpointed.
+    pair_wake: Vec<f64>,
+    /// Upper bound, m, on the distance any particle has moved since the lists were built:
+    /// the sum over steps of the largest |v| Δt, each rounded up. Derived, not checkpointed.
+    travel: f64,
+    /// What one step adds to the travel besides the largest |v| Δt, m: a bound on the
+    /// rounding of x + v Δt at the coordinates of the scene.
+    travel_slack: f64,
+    /// What the last step added to the travel, m.
+    travel_step: f64,
     pair_out: Vec<PairOut>,
     /// Record-only values of each pair (see [`PairDetail`]).
     pair_detail: Vec<PairDetail>,
@@ -346,10 +364,17 @@ pub struct Simulation {
     pub(crate) reference_wall_offset: Vec<Vec3>,
     pub(crate) needs_rebuild: bool,
     // ---- derived, rebuilt from the state
-    /// Gather lists: `csr_entry[csr_offset[i]..csr_offset[i + 1]]` are the indices, in
-    /// increasing order, of the pairs in which particle i is the second particle (j).
-    pub(crate) csr_offset: Vec<u32>,
-    pub(crate) csr_entry: Vec<u32>,
+    /// Gather lists of the pairs in contact: `active_entry[active_base[i]..][..active_len[i]]`
+    /// holds, in increasing order, 2e + 1 for each active pair e in which particle i is the
+    /// first particle and 2e where it is the second. The room of particle i is the number of
+    /// its candidate pairs, so the list never overflows; it is kept in step with
+    /// `pair_active` by [`Simulation::sync_active_lists`] after each force phase, from the
+    /// few contacts that began or ended.
+    active_base: Vec<u32>,
+    active_len: Vec<u32>,
+    active_entry: Vec<u32>,
+    /// `pair_active` as the gather lists hold it.
+    pair_listed: Vec<bool>,
     /// The pairs in which particle i is the first particle are
     /// `pairs[pair_start[i]..pair_start[i + 1]]` (the list is sorted by (i, j)).
     pub(crate) pair_start: Vec<u32>,
@@ -367,8 +392,12 @@ pub struct Simulation {
     old_pair_active: Vec<bool>,
     old_slots: Vec<WallContact>,
     wall_state: Vec<WallState>,
-    chunk_onsets: Vec<u32>,
-    chunk_results: Vec<(f64, bool, u32)>,
+    /// Contacts begun and ended in each chunk of `PAIR_CHUNK` pairs at the last force
+    /// evaluation.
+    chunk_onsets: Vec<Flips>,
+    /// Per block of the particle phase: (largest squared displacement since the last rebuild,
+    /// m², largest squared speed, m²/s², any non-finite value, wall onsets).
+    chunk_results: Vec<(f64, f64, bool, u32)>,
     pub(crate) contact_force_sum: Vec<Vec3>,
     pub(crate) coordination: Vec<u32>,
     pub(crate) wall_coordination: Vec<u32>,
@@ -423,6 +452,11 @@ struct PairCtx<'a> {
     /// radius (m): (entry, radius). The batched pair kernel then writes the constants and
     /// radii into its batch once per chunk instead of once per contact.
     pairs_uniform: Option<(u32, f64)>,
+    /// The travel bound of this force evaluation, m (see [`Simulation::travel`]).
+    travel: f64,
+    /// A pair is skipped only if half its gap exceeds this, m: `SKIP_STEPS` times the
+    /// travel of the last step.
+    min_skip: f64,
 }
 
 /// Read-only context of the wall kernels (run in the force phase, next to the pairs).
@@ -437,12 +471,12 @@ struct WallCtx<'a> {
 
 /// Read-only context of the particle phase.
 struct ParticleCtx<'a> {
-    pair_active: &'a [bool],
     pair_rolling: &'a [Vec3],
     pair_out: &'a [PairOut],
-    csr_offset: &'a [u32],
-    csr_entry: &'a [u32],
-    pair_start: &'a [u32],
+    /// The gather lists (see [`Simulation::active_entry`]).
+    active_base: &'a [u32],
+    active_len: &'a [u32],
+    active_entry: &'a [u32],
     radius: &'a [f64],
     inv_mass: &'a [f64],
     inv_inertia: &'a [f64],
@@ -492,14 +526,34 @@ fn tangential_force(
 }
 
 /// One thread's block of the parallel force phase (see `Simulation::part_cuts`).
-struct ForcePart<'a> {
-    pairs: &'a mut [PairContact],
+/// Contacts begun (onsets) and ended in one chunk of the pair list at one force evaluation.
+#[derive(Debug, Clone, Copy, Default)]
+struct Flips {
+    onsets: u32,
+    ends: u32,
+}
+
+/// The per-pair arrays of one chunk of the pair list that the pair kernels write, cut to
+/// the chunk (index e = pair − chunk start).
+struct PairLists<'a> {
+    /// In contact at the last force evaluation.
     active: &'a mut [bool],
+    /// See [`Simulation::pair_wake`].
+    wake: &'a mut [f64],
     out: &'a mut [PairOut],
     detail: &'a mut [PairDetail],
     rolling: &'a mut [Vec3],
-    /// Onsets of each of the block's pair chunks.
-    onsets: &'a mut [u32],
+}
+
+struct ForcePart<'a> {
+    pairs: &'a mut [PairContact],
+    active: &'a mut [bool],
+    wake: &'a mut [f64],
+    out: &'a mut [PairOut],
+    detail: &'a mut [PairDetail],
+    rolling: &'a mut [Vec3],
+    /// Onsets and ends of each of the block's pair chunks.
+    onsets: &'a mut [Flips],
     slots: &'a mut [WallContact],
     wall_out: &'a mut [WallOut],
     wall_detail: &'a mut [WallDetail],
@@ -637,8 +691,9 @@ fn law_at<const E: u16>(
 }
 
 /// The centre distance x_j − x_i and its square when pair `p` touches; otherwise ends a
-/// contact that was active (flags, history, the gather's overlap) and returns `None`.
-/// Shared by [`pair_kernel`] and the batched kernel.
+/// contact that was active (flags, history, the gather's overlap) and returns the squared
+/// distance and whether a contact ended as the error. Shared by [`pair_kernel`] and the
+/// batched kernel.
 #[inline(always)]
 fn pair_in_reach(
     p: &mut PairContact,
@@ -646,21 +701,41 @@ fn pair_in_reach(
     out: &mut PairOut,
     position: &[Vec3],
     reach2: f64,
-) -> Option<(Vec3, f64)> {
+) -> std::result::Result<(Vec3, f64), (f64, bool)> {
     let d = position[p.j as usize] - position[p.i as usize];
     let dist2 = d.length_squared();
     if dist2 >= reach2 || dist2 == 0.0 {
         // an inactive pair has nothing to reset: its output slot already reads "no contact"
         // (onset is only ever set together with active)
-        if *active {
+        let ended = *active;
+        if ended {
             *active = false;
             p.onset = false;
             p.history = Vec3::ZERO;
             out.overlap = 0.0;
         }
-        return None;
+        return Err((dist2, ended));
     }
-    Some((d, dist2))
+    Ok((d, dist2))
+}
+
+/// The travel (see [`Simulation::pair_wake`]) below which a pair whose centres are
+/// √`dist2` apart, `r_sum` (m) needed to touch, found so when the travel was `travel`,
+/// cannot touch: each particle moves at most the travel's growth, so the gap closes at most
+/// twice as fast. The margin (a relative 1e-9 of the gap and 64 ε r_sum) covers the rounding
+/// of the distances, far below any physical length of a scene. A pair that could touch
+/// within a few steps (half its gap below `min_skip`, m) is tested every step instead
+/// (−∞): the kernel's skip test then follows a steady pattern the branch predictor learns,
+/// rather than turning every few steps.
+#[inline(always)]
+fn wake_travel(travel: f64, dist2: f64, r_sum: f64, min_skip: f64) -> f64 {
+    let gap = dist2.sqrt() - r_sum;
+    let half = 0.5 * (gap * (1.0 - 1e-9) - 64.0 * f64::EPSILON * r_sum);
+    if half > min_skip {
+        travel + half
+    } else {
+        f64::NEG_INFINITY
+    }
 }
 
 /// Where and how a particle of radius `r` at `x` touches the wall of slot `s`.
@@ -744,9 +819,15 @@ fn pair_kernel<const E: u16>(
     detail: &mut PairDetail,
     rolling_torque: &mut Vec3,
     c: &PairCtx<'_>,
-) -> bool {
-    let Some((d, dist2)) = pair_in_reach(p, active, out, c.position, p.r_sum * p.r_sum) else {
-        return false;
+) -> Flips {
+    let (d, dist2) = match pair_in_reach(p, active, out, c.position, p.r_sum * p.r_sum) {
+        Ok(hit) => hit,
+        Err((_, ended)) => {
+            return Flips {
+                onsets: 0,
+                ends: ended as u32,
+            }
+        }
     };
     let (i, j) = (p.i as usize, p.j as usize);
     let r_sum = p.r_sum;
@@ -816,31 +897,38 @@ fn pair_kernel<const E: u16>(
         torque_per_arm,
         overlap,
     };
-    onset
+    Flips {
+        onsets: onset as u32,
+        ends: 0,
+    }
 }
 
-/// Pair kernels of one chunk of the pair list; returns the number of onsets.
+/// Pair kernels of one chunk of the pair list; returns the contacts begun and ended.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn pair_chunk<const E: u16>(
     chunk: &mut [PairContact],
-    active: &mut [bool],
-    out: &mut [PairOut],
-    detail: &mut [PairDetail],
-    rolling: &mut [Vec3],
+    lists: PairLists<'_>,
     konst: &[u32],
     c: &PairCtx<'_>,
     batch: &mut Batch,
-) -> u32 {
+) -> Flips {
     if c.batched && !on::<E>(c.effects, Effect::RollingResistance) {
         return match c.pairs_uniform {
-            Some(_) if c.avx2 => {
-                pair_chunk_batched::<E, true>(chunk, active, out, detail, konst, c, batch)
-            }
-            _ => pair_chunk_batched::<E, false>(chunk, active, out, detail, konst, c, batch),
+            Some(_) if c.avx2 => pair_chunk_batched::<E, true>(chunk, lists, konst, c, batch),
+            _ => pair_chunk_batched::<E, false>(chunk, lists, konst, c, batch),
         };
     }
-    let mut onsets = 0u32;
+    // one at a time: every pair is tested (its wake stays a valid bound, see
+    // `Simulation::pair_wake`, as the travel keeps growing)
+    let PairLists {
+        active,
+        out,
+        detail,
+        rolling,
+        ..
+    } = lists;
+    let mut flips = Flips::default();
     for (((((p, a), o), d), r), k) in chunk
         .iter_mut()
         .zip(active.iter_mut())
@@ -849,9 +937,11 @@ fn pair_chunk<const E: u16>(
         .zip(rolling.iter_mut())
         .zip(konst)
     {
-        onsets += pair_kernel::<E>(p, a, &c.table[*k as usize], o, d, r, c) as u32;
+        let f = pair_kernel::<E>(p, a, &c.table[*k as usize], o, d, r, c);
+        flips.onsets += f.onsets;
+        flips.ends += f.ends;
     }
-    onsets
+    flips
 }
 
 /// The kernel entry points ([`pair_chunk`], [`wall_chunk`], [`particle_chunk`]) compiled a
@@ -890,14 +980,11 @@ mod simd {
 
     avx2_dispatch!(pair, pair_chunk_avx2, pair_chunk, (
         chunk: &mut [PairContact],
-        active: &mut [bool],
-        out: &mut [PairOut],
-        detail: &mut [PairDetail],
-        rolling: &mut [Vec3],
+        lists: PairLists<'_>,
         konst: &[u32],
         c: &PairCtx<'_>,
         batch: &mut Batch
-    ) -> u32);
+    ) -> Flips);
 
     avx2_dispatch!(wall, wall_chunk_avx2, wall_chunk, (
         c: &WallCtx<'_>,
@@ -920,7 +1007,7 @@ mod simd {
         wall_coordination: &mut [u32],
         slots: &[WallContact],
         wall_out: &[WallOut]
-    ) -> (f64, bool, u32));
+    ) -> (f64, f64, bool, u32));
 }
 
 /// Closest point, unit normal (wall → x) and distance of a wall slot when the sphere of
@@ -1080,10 +1167,9 @@ struct Gather<'a> {
     c: &'a ParticleCtx<'a>,
     /// The chunk's slices (index k = particle − first).
     radius: &'a [f64],
-    offset: &'a [u32],
-    pair_start: &'a [u32],
+    active_base: &'a [u32],
+    active_len: &'a [u32],
     /// The pair arrays, cut to one length.
-    pair_active: &'a [bool],
     pair_out: &'a [PairOut],
     pair_rolling: &'a [Vec3],
     slots: &'a [WallContact],
@@ -1099,9 +1185,8 @@ impl Gather<'_> {
         let Gather {
             c,
             radius,
-            offset,
-            pair_start,
-            pair_active,
+            active_base,
+            active_len,
             pair_out,
             pair_rolling,
             slots,
@@ -1114,41 +1199,28 @@ impl Gather<'_> {
         let mut f = Vec3::ZERO;
         let mut t = Vec3::ZERO;
         let mut z = 0u32;
-        // pairs in increasing index order: first those where the particle is j (their i is
-        // smaller, so their indices come first), listed in the CSR ...
-        for &e in &c.csr_entry[offset[k] as usize..offset[k + 1] as usize] {
-            let e = e as usize;
-            let Some(true) = pair_active.get(e) else {
+        // the pairs in contact in increasing index order (those where the particle is j
+        // first, as their i is smaller); the force on i is +force, on j −force: added times
+        // ±1, which is exactly the subtraction
+        let start = active_base[k] as usize;
+        let listed = c
+            .active_entry
+            .get(start..start + active_len[k] as usize)
+            .unwrap_or(&[]);
+        for &a in listed {
+            let e = (a >> 1) as usize;
+            let Some(p) = pair_out.get(e) else {
                 continue;
             };
-            let p = &pair_out[e];
+            // +1.0 for the first particle (a odd), −1.0 for the second: the sign bit
+            let sign = f64::from_bits(1.0f64.to_bits() | (u64::from(!a & 1) << 63));
             z += 1;
-            f -= p.force;
+            f += p.force * sign;
             if rotation {
                 let arm = radius[k] - 0.5 * p.overlap;
                 t += arm * p.torque_per_arm;
                 if rolling {
-                    t -= pair_rolling[e];
-                }
-            }
-        }
-        // ... then those where it is i: a contiguous range of the sorted pair list
-        let own = pair_start[k] as usize..pair_start[k + 1] as usize;
-        for (e, (&on, p)) in pair_active[own.clone()]
-            .iter()
-            .zip(&pair_out[own.clone()])
-            .enumerate()
-        {
-            if !on {
-                continue;
-            }
-            z += 1;
-            f += p.force;
-            if rotation {
-                let arm = radius[k] - 0.5 * p.overlap;
-                t += arm * p.torque_per_arm;
-                if rolling {
-                    t += pair_rolling[own.start + e];
+                    t += pair_rolling[e] * sign;
                 }
             }
         }
@@ -1177,7 +1249,8 @@ impl Gather<'_> {
 }
 
 /// Particle phase on one chunk of particles starting at `first`. Returns (largest squared
-/// displacement since the last rebuild, any non-finite value, wall onsets).
+/// displacement since the last rebuild (m²), largest squared new speed (m²/s²), any
+/// non-finite value, wall onsets).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn particle_chunk<const E: u16>(
@@ -1191,7 +1264,7 @@ fn particle_chunk<const E: u16>(
     wall_coordination: &mut [u32],
     slots: &[WallContact],
     wall_out: &[WallOut],
-) -> (f64, bool, u32) {
+) -> (f64, f64, bool, u32) {
     let rotation = on::<E>(c.effects, Effect::Rotation);
     let rolling = on::<E>(c.effects, Effect::RollingResistance);
     let planar = on::<E>(c.effects, Effect::Planar);
@@ -1201,6 +1274,7 @@ fn particle_chunk<const E: u16>(
         Vec3::ZERO
     };
     let mut max_disp2: f64 = 0.0;
+    let mut max_v2: f64 = 0.0;
     // 0 × finite = 0 while 0 × (inf or NaN) = NaN: one multiply-add per particle instead of
     // nine finiteness tests, checked once per chunk
     let mut probe = Vec3::ZERO;
@@ -1214,14 +1288,13 @@ fn particle_chunk<const E: u16>(
     let inv_mass = &c.inv_mass[first..last];
     let inv_inertia = &c.inv_inertia[first..last];
     let reference = &c.reference_position[first..last];
-    let offset = &c.csr_offset[first..=last];
-    let pair_start = &c.pair_start[first..=last];
+    let active_base = &c.active_base[first..last];
+    let active_len = &c.active_len[first..last];
     let (velocity, omega) = (&mut velocity[..len], &mut omega[..len]);
     let (force_sum, coordination) = (&mut force_sum[..len], &mut coordination[..len]);
     let wall_coordination = &mut wall_coordination[..len];
-    // the pair arrays cut to one length, so one bounds check covers the three
     let n_pairs = c.pair_out.len();
-    let (pair_active, pair_out) = (&c.pair_active[..n_pairs], &c.pair_out[..n_pairs]);
+    let pair_out = &c.pair_out[..n_pairs];
     let pair_rolling = if rolling {
         &c.pair_rolling[..n_pairs]
     } else {
@@ -1232,9 +1305,8 @@ fn particle_chunk<const E: u16>(
     let g = Gather {
         c,
         radius,
-        offset,
-        pair_start,
-        pair_active,
+        active_base,
+        active_len,
         pair_out,
         pair_rolling,
         slots,
@@ -1261,7 +1333,7 @@ fn particle_chunk<const E: u16>(
                 }
             }
             // SAFETY: `avx2` is set only when the CPU reported AVX2.
-            let (disp2, p) = unsafe {
+            let (disp2, v2, p) = unsafe {
                 batch::advance4::<E>(
                     &ft,
                     &mut position[k..k + 4],
@@ -1278,6 +1350,9 @@ fn particle_chunk<const E: u16>(
             probe.x += p;
             if disp2 > max_disp2 {
                 max_disp2 = disp2;
+            }
+            if v2 > max_v2 {
+                max_v2 = v2;
             }
             k += 4;
             continue;
@@ -1313,9 +1388,13 @@ fn particle_chunk<const E: u16>(
         if disp2 > max_disp2 {
             max_disp2 = disp2;
         }
+        let v2 = v_new.length_squared();
+        if v2 > max_v2 {
+            max_v2 = v2;
+        }
         k += 1;
     }
-    (max_disp2, !probe.is_finite(), wall_onsets)
+    (max_disp2, max_v2, !probe.is_finite(), wall_onsets)
 }
 
 impl Simulation {
@@ -1427,6 +1506,10 @@ impl Simulation {
             steps: 0,
             pairs: Vec::new(),
             pair_active: Vec::new(),
+            pair_wake: Vec::new(),
+            travel: 0.0,
+            travel_slack: 0.0,
+            travel_step: 0.0,
             part_cuts: Vec::new(),
             wall_lists: WallLists::default(),
             pair_out: Vec::new(),
@@ -1442,8 +1525,10 @@ impl Simulation {
             reference_position: p.position.clone(),
             reference_wall_offset: vec![Vec3::ZERO; scene.walls.len()],
             needs_rebuild: true,
-            csr_offset: vec![0; n + 1],
-            csr_entry: Vec::new(),
+            active_base: vec![0; n + 1],
+            active_len: vec![0; n],
+            active_entry: Vec::new(),
+            pair_listed: Vec::new(),
             pair_start: vec![0; n + 1],
             grid: CellGrid::default(),
             candidate_scratch: Vec::new(),
@@ -1516,10 +1601,10 @@ impl Simulation {
         }
     }
 
-    /// Gather lists: for each particle, the pairs where it is j (CSR, increasing pair index)
-    /// and the range of pairs where it is i (`pair_start`; the pair list is sorted by (i, j)).
-    /// Visiting the first, then the second, visits a particle's pairs in increasing index
-    /// order. A pure function of the pair list.
+    /// The lists derived from the pair list and `pair_active`: the range of pairs where
+    /// each particle is i (`pair_start`; the pair list is sorted by (i, j)), the threads'
+    /// cuts, and the gather lists of the pairs in contact (see [`Simulation::active_entry`]),
+    /// in increasing pair index; every pair is tested at the next step (`pair_wake`).
     pub(crate) fn build_gather_lists(&mut self) {
         let n = self.position.len();
         self.pair_out.clear();
@@ -1529,17 +1614,18 @@ impl Simulation {
             .resize(self.pairs.len(), PairDetail::default());
         self.pair_rolling.clear();
         self.pair_rolling.resize(self.pairs.len(), Vec3::ZERO);
-        self.csr_offset.clear();
-        self.csr_offset.resize(n + 1, 0);
+        self.active_base.clear();
+        self.active_base.resize(n + 1, 0);
         self.pair_start.clear();
         self.pair_start.resize(n + 1, 0);
         for p in &self.pairs {
             self.pair_start[p.i as usize + 1] += 1;
-            self.csr_offset[p.j as usize + 1] += 1;
+            self.active_base[p.i as usize + 1] += 1;
+            self.active_base[p.j as usize + 1] += 1;
         }
         for i in 0..n {
             self.pair_start[i + 1] += self.pair_start[i];
-            self.csr_offset[i + 1] += self.csr_offset[i];
+            self.active_base[i + 1] += self.active_base[i];
         }
         self.part_cuts.clear();
         let parts = self.threads.max(1);
@@ -1551,12 +1637,76 @@ impl Simulation {
             last = (p, e);
             self.part_cuts.push(last);
         }
-        self.csr_entry.clear();
-        self.csr_entry.resize(self.csr_offset[n] as usize, 0);
-        let mut fill: Vec<u32> = self.csr_offset[..n].to_vec();
-        for (k, p) in self.pairs.iter().enumerate() {
-            self.csr_entry[fill[p.j as usize] as usize] = k as u32;
-            fill[p.j as usize] += 1;
+        // the gather lists of the pairs in contact, in increasing pair order
+        self.active_entry.clear();
+        self.active_entry.resize(self.active_base[n] as usize, 0);
+        self.active_len.clear();
+        self.active_len.resize(n, 0);
+        for (e, (p, &on)) in self.pairs.iter().zip(&self.pair_active).enumerate() {
+            if on {
+                for (k, side) in [(p.i as usize, 1), (p.j as usize, 0)] {
+                    let at = (self.active_base[k] + self.active_len[k]) as usize;
+                    self.active_entry[at] = 2 * e as u32 + side;
+                    self.active_len[k] += 1;
+                }
+            }
+        }
+        self.pair_listed.clone_from(&self.pair_active);
+        // every pair is tested at the next force evaluation; the travel starts again
+        self.pair_wake.clear();
+        self.pair_wake.resize(self.pairs.len(), f64::NEG_INFINITY);
+        self.travel = 0.0;
+        // x + v Δt rounds each coordinate by at most ε |x|; particles stay within half a
+        // skin of where they are now until the next rebuild: 2ε (|x|max + skin) bounds the
+        // rounding of one step's move (√3 < 2)
+        let extent = self
+            .position
+            .iter()
+            .map(|x| x.abs().max_element())
+            .filter(|m| m.is_finite())
+            .fold(0.0, f64::max);
+        self.travel_slack = 2.0 * f64::EPSILON * (extent + self.skin);
+    }
+
+    /// Bring the gather lists in step with `pair_active` after a force phase: only the
+    /// chunks of pairs in which a contact began or ended are looked at, and each such pair
+    /// is inserted into (or removed from) the sorted lists of its two particles.
+    fn sync_active_lists(&mut self) {
+        for (c, flips) in self.chunk_onsets.iter().enumerate() {
+            if flips.onsets == 0 && flips.ends == 0 {
+                continue;
+            }
+            let end = ((c + 1) * PAIR_CHUNK).min(self.pairs.len());
+            for e in c * PAIR_CHUNK..end {
+                let on = self.pair_active[e];
+                if on == self.pair_listed[e] {
+                    continue;
+                }
+                self.pair_listed[e] = on;
+                let p = &self.pairs[e];
+                for (k, side) in [(p.i as usize, 1), (p.j as usize, 0)] {
+                    let entry = 2 * e as u32 + side;
+                    let base = self.active_base[k] as usize;
+                    let len = self.active_len[k] as usize;
+                    if on {
+                        // insertion into the sorted list (its room is every candidate of k)
+                        let list = &mut self.active_entry[base..=base + len];
+                        let mut at = len;
+                        while at > 0 && list[at - 1] > entry {
+                            list[at] = list[at - 1];
+                            at -= 1;
+                        }
+                        list[at] = entry;
+                        self.active_len[k] += 1;
+                    } else {
+                        let list = &mut self.active_entry[base..base + len];
+                        if let Some(at) = list.iter().position(|&x| x == entry) {
+                            list.copy_within(at + 1.., at);
+                            self.active_len[k] -= 1;
+                        }
+                    }
+                }
+            }
         }
     }
 
@@ -1895,6 +2045,8 @@ impl Simulation {
                 batched: self.batched,
                 pairs_hertz: self.pairs_hertz,
                 pairs_uniform: self.pairs_uniform,
+                travel: self.travel,
+                min_skip: SKIP_STEPS * self.travel_step,
             };
             let wall_ctx = WallCtx {
                 shared: pair_ctx,
@@ -1906,31 +2058,40 @@ impl Simulation {
             type PairChunk<'c> = (
                 (
                     (
-                        ((&'c mut [PairContact], &'c mut [bool]), &'c mut [PairOut]),
+                        (
+                            ((&'c mut [PairContact], &'c mut [bool]), &'c mut [f64]),
+                            &'c mut [PairOut],
+                        ),
                         &'c mut [PairDetail],
                     ),
                     &'c mut [Vec3],
                 ),
                 &'c [u32],
             );
-            let kernel =
-                |(((((chunk, active), out), detail), rolling), konst): PairChunk<'_>| -> u32 {
-                    BATCH_SCRATCH.with_borrow_mut(|b| {
-                        simd::pair::<E>(
-                            avx2, chunk, active, out, detail, rolling, konst, &pair_ctx, b,
-                        )
-                    })
+            let kernel = |((((((chunk, active), wake), out), detail), rolling), konst): PairChunk<
+                '_,
+            >|
+             -> Flips {
+                let lists = PairLists {
+                    active,
+                    wake,
+                    out,
+                    detail,
+                    rolling,
                 };
+                BATCH_SCRATCH
+                    .with_borrow_mut(|b| simd::pair::<E>(avx2, chunk, lists, konst, &pair_ctx, b))
+            };
             let (pairs, pair_out, pair_const) =
                 (&mut self.pairs, &mut self.pair_out, &self.pair_const);
             let (pair_detail, pair_rolling) = (&mut self.pair_detail, &mut self.pair_rolling);
-            let pair_active = &mut self.pair_active;
+            let (pair_active, pair_wake) = (&mut self.pair_active, &mut self.pair_wake);
             let (onsets, slots) = (&mut self.chunk_onsets, &mut self.wall_slots);
             let (wall_out, wall_detail) = (&mut self.wall_out, &mut self.wall_detail);
             let cut = &self.part_cuts;
             let wall_lists = &self.wall_lists;
             onsets.clear();
-            onsets.resize(pairs.len().div_ceil(PAIR_CHUNK), 0);
+            onsets.resize(pairs.len().div_ceil(PAIR_CHUNK), Flips::default());
             let run = |(t, part): (usize, ForcePart<'_>)| {
                 let (first_particle, first_pair) = if t == 0 { (0, 0) } else { cut[t - 1] };
                 let konst = &pair_const[first_pair..first_pair + part.pairs.len()];
@@ -1938,6 +2099,7 @@ impl Simulation {
                     .pairs
                     .chunks_mut(PAIR_CHUNK)
                     .zip(part.active.chunks_mut(PAIR_CHUNK))
+                    .zip(part.wake.chunks_mut(PAIR_CHUNK))
                     .zip(part.out.chunks_mut(PAIR_CHUNK))
                     .zip(part.detail.chunks_mut(PAIR_CHUNK))
                     .zip(part.rolling.chunks_mut(PAIR_CHUNK))
@@ -1974,6 +2136,7 @@ impl Simulation {
                 let parts: Vec<_> = split_at_cuts(pairs, &pair_cuts)
                     .into_iter()
                     .zip(split_at_cuts(pair_active, &pair_cuts))
+                    .zip(split_at_cuts(pair_wake, &pair_cuts))
                     .zip(split_at_cuts(pair_out, &pair_cuts))
                     .zip(split_at_cuts(pair_detail, &pair_cuts))
                     .zip(split_at_cuts(pair_rolling, &pair_cuts))
@@ -1981,17 +2144,20 @@ impl Simulation {
                     .zip(split_at_cuts(slots, &slot_cuts))
                     .zip(split_at_cuts(wall_out, &slot_cuts))
                     .zip(split_at_cuts(wall_detail, &slot_cuts))
-                    .map(|((((((((p, a), o), d), r), on), s), wo), wd)| ForcePart {
-                        pairs: p,
-                        active: a,
-                        out: o,
-                        detail: d,
-                        rolling: r,
-                        onsets: on,
-                        slots: s,
-                        wall_out: wo,
-                        wall_detail: wd,
-                    })
+                    .map(
+                        |(((((((((p, a), k), o), d), r), on), s), wo), wd)| ForcePart {
+                            pairs: p,
+                            active: a,
+                            wake: k,
+                            out: o,
+                            detail: d,
+                            rolling: r,
+                            onsets: on,
+                            slots: s,
+                            wall_out: wo,
+                            wall_detail: wd,
+                        },
+                    )
                     .enumerate()
                     .collect();
                 join_parts(parts.into_iter(), &run);
@@ -1999,6 +2165,7 @@ impl Simulation {
                 let whole = ForcePart {
                     pairs,
                     active: pair_active,
+                    wake: pair_wake,
                     out: pair_out,
                     detail: pair_detail,
                     rolling: pair_rolling,
@@ -2010,15 +2177,15 @@ impl Simulation {
                 run((0, whole));
             }
         }
+        self.sync_active_lists();
         // ---- particle phase: gather in list order, advance
         {
             let ctx = ParticleCtx {
-                pair_active: &self.pair_active,
                 pair_rolling: &self.pair_rolling,
                 pair_out: &self.pair_out,
-                csr_offset: &self.csr_offset,
-                csr_entry: &self.csr_entry,
-                pair_start: &self.pair_start,
+                active_base: &self.active_base,
+                active_len: &self.active_len,
+                active_entry: &self.active_entry,
                 radius: &self.radius,
                 inv_mass: &self.inv_mass,
                 inv_inertia: &self.inv_inertia,
@@ -2037,7 +2204,7 @@ impl Simulation {
                 let n_parts = cuts.len() + 1;
                 let result_cuts: Vec<usize> = (1..n_parts).collect();
                 self.chunk_results.clear();
-                self.chunk_results.resize(n_parts, (0.0, false, 0));
+                self.chunk_results.resize(n_parts, (0.0, 0.0, false, 0));
                 let parts: Vec<_> = split_at_cuts(&mut self.position, &cuts)
                     .into_iter()
                     .zip(split_at_cuts(&mut self.velocity, &cuts))
@@ -2060,7 +2227,7 @@ impl Simulation {
                         ),
                         &'c mut [u32],
                     ),
-                    &'c mut [(f64, bool, u32)],
+                    &'c mut [(f64, f64, bool, u32)],
                 );
                 let run = |(t, ((((((x, v), w), f), z), zw), res)): (usize, Part<'_>)| {
                     let first = if t == 0 { 0 } else { cuts[t - 1] };
@@ -2095,14 +2262,23 @@ impl Simulation {
         let mut max_disp2: f64 = 0.0;
         let mut bad = false;
         let mut wall_onsets = 0u32;
-        for &(d, b, o) in &self.chunk_results {
+        let mut max_v2: f64 = 0.0;
+        for &(d, v2, b, o) in &self.chunk_results {
             max_disp2 = max_disp2.max(d);
+            max_v2 = max_v2.max(v2);
             bad |= b;
             wall_onsets += o;
         }
         if self.record_onsets {
             self.log_onsets(wall_onsets > 0);
         }
+        // the travel bound: no particle moved further than |v| Δt this step, up to the
+        // rounding of |v|, of the product and of x + v Δt (the slack), and the sum's own
+        // rounding (a relative 2ε of the travel)
+        self.travel_step = max_v2.sqrt() * self.dt * (1.0 + 1e-12)
+            + self.travel_slack
+            + 2.0 * f64::EPSILON * self.travel;
+        self.travel += self.travel_step;
         self.steps += 1;
         self.time = self.steps as f64 * self.dt;
         if bad {
@@ -2129,8 +2305,8 @@ impl Simulation {
     fn log_onsets(&mut self, walls: bool) {
         let time = self.time;
         let step = self.steps;
-        for (c, &count) in self.chunk_onsets.iter().enumerate() {
-            if count == 0 {
+        for (c, count) in self.chunk_onsets.iter().enumerate() {
+            if count.onsets == 0 {
                 continue;
             }
             let end = ((c + 1) * PAIR_CHUNK).min(self.pairs.len());
@@ -2290,6 +2466,13 @@ impl Simulation {
             .iter()
             .filter(|s| s.wall != NO_WALL && s.planar_pass)
             .count()
+    }
+
+    /// How many candidate pairs out of contact the batched pair kernel will skip at the next
+    /// step because they cannot have closed their gap yet (see [`Simulation::pair_wake`]); a
+    /// diagnostic for tests and benchmarks.
+    pub fn sleeping_pairs(&self) -> usize {
+        self.pair_wake.iter().filter(|&&w| self.travel < w).count()
     }
 
     /// Whether the batched AVX2 pair kernel takes the uniform path: every pair indexes one

@@ -417,7 +417,7 @@ mod avx2_forces {
         gravity: Vec3,
         dt: f64,
         effects: EffectSet,
-    ) -> (f64, f64) {
+    ) -> (f64, f64, f64) {
         let rotation = on::<E>(effects, Effect::Rotation);
         let planar = on::<E>(effects, Effect::Planar);
         let (x, v, w) = (&mut x[..4], &mut v[..4], &mut w[..4]);
@@ -463,6 +463,7 @@ mod avx2_forces {
         }
         let d = sub(x_new, load_aos4(reference.as_ptr()));
         let disp2 = lanes(dot(d, d));
+        let speed2 = lanes(dot(v_new, v_new));
         let p = lanes(probe);
         let mut max = 0.0;
         for q in disp2 {
@@ -470,7 +471,13 @@ mod avx2_forces {
                 max = q;
             }
         }
-        (max, (p[0] + p[1]) + (p[2] + p[3]))
+        let mut max_v2 = 0.0;
+        for q in speed2 {
+            if q > max_v2 {
+                max_v2 = q;
+            }
+        }
+        (max, max_v2, (p[0] + p[1]) + (p[2] + p[3]))
     }
 
     /// The lanes of `v` as an array.
@@ -886,30 +893,31 @@ const _: () = {
 #[inline(always)]
 pub(super) fn pair_chunk_batched<const E: u16, const U: bool>(
     chunk: &mut [PairContact],
-    active: &mut [bool],
-    out: &mut [PairOut],
-    detail: &mut [PairDetail],
+    lists: PairLists<'_>,
     konst: &[u32],
     c: &PairCtx<'_>,
     b: &mut Batch,
-) -> u32 {
+) -> Flips {
     let rotation = on::<E>(c.effects, Effect::Rotation);
     // every pair's law is evaluated by the AVX2 force pass: no per-pair test of the law
     let hertz = c.avx2 && c.pairs_hertz;
     // one law entry and one radius for every pair: written into the batch once per chunk
-    let mut uniform_reach2 = 0.0;
+    let (mut uniform_reach2, mut uniform_r_sum) = (0.0, 0.0);
     if U {
         if let Some((k, r)) = c.pairs_uniform {
             b.fill_uniform(&c.table[k as usize], r);
             uniform_reach2 = (r + r) * (r + r);
+            uniform_r_sum = r + r;
         }
     }
-    let mut onsets = 0u32;
+    let travel = c.travel;
+    let (mut onsets, mut ends) = (0u32, 0u32);
     let len = chunk.len();
-    let (active, out, detail, konst) = (
-        &mut active[..len],
-        &mut out[..len],
-        &mut detail[..len],
+    let (active, wake, out, detail, konst) = (
+        &mut lists.active[..len],
+        &mut lists.wake[..len],
+        &mut lists.out[..len],
+        &mut lists.detail[..len],
         &konst[..len],
     );
     // the particle arrays cut to the positions' length: a pair that passed the reach test
@@ -924,12 +932,21 @@ pub(super) fn pair_chunk_batched<const E: u16, const U: bool>(
         while next < len && b.len < BATCH {
             let e = next;
             next += 1;
+            // a pair out of contact that cannot have closed its gap yet: nothing to do
+            if travel < wake[e] {
+                continue;
+            }
             let p = &mut chunk[e];
             let reach2 = if U { uniform_reach2 } else { p.r_sum * p.r_sum };
-            let Some((d, dist2)) =
-                pair_in_reach(p, &mut active[e], &mut out[e], c.position, reach2)
-            else {
-                continue;
+            let (d, dist2) = match pair_in_reach(p, &mut active[e], &mut out[e], c.position, reach2)
+            {
+                Ok(hit) => hit,
+                Err((dist2, ended)) => {
+                    ends += ended as u32;
+                    let r_sum = if U { uniform_r_sum } else { p.r_sum };
+                    wake[e] = wake_travel(travel, dist2, r_sum, c.min_skip);
+                    continue;
+                }
             };
             let (i, j) = (p.i as usize, p.j as usize);
             let k = b.len;
@@ -988,7 +1005,7 @@ pub(super) fn pair_chunk_batched<const E: u16, const U: bool>(
             };
         }
     }
-    onsets
+    Flips { onsets, ends }
 }
 
 /// The wall slots of one chunk of particles starting at `first`, in batches (see [`Batch`]):
