@@ -547,11 +547,8 @@ struct PairLists<'a> {
 
 struct ForcePart<'a> {
     pairs: &'a mut [PairContact],
-    active: &'a mut [bool],
-    wake: &'a mut [f64],
-    out: &'a mut [PairOut],
-    detail: &'a mut [PairDetail],
-    rolling: &'a mut [Vec3],
+    /// The block's pair arrays (cut into chunks for the kernels).
+    lists: PairLists<'a>,
     /// Onsets and ends of each of the block's pair chunks.
     onsets: &'a mut [Flips],
     slots: &'a mut [WallContact],
@@ -2098,11 +2095,11 @@ impl Simulation {
                 let chunks = part
                     .pairs
                     .chunks_mut(PAIR_CHUNK)
-                    .zip(part.active.chunks_mut(PAIR_CHUNK))
-                    .zip(part.wake.chunks_mut(PAIR_CHUNK))
-                    .zip(part.out.chunks_mut(PAIR_CHUNK))
-                    .zip(part.detail.chunks_mut(PAIR_CHUNK))
-                    .zip(part.rolling.chunks_mut(PAIR_CHUNK))
+                    .zip(part.lists.active.chunks_mut(PAIR_CHUNK))
+                    .zip(part.lists.wake.chunks_mut(PAIR_CHUNK))
+                    .zip(part.lists.out.chunks_mut(PAIR_CHUNK))
+                    .zip(part.lists.detail.chunks_mut(PAIR_CHUNK))
+                    .zip(part.lists.rolling.chunks_mut(PAIR_CHUNK))
                     .zip(konst.chunks(PAIR_CHUNK));
                 for (slot, chunk) in part.onsets.iter_mut().zip(chunks) {
                     *slot = kernel(chunk);
@@ -2147,11 +2144,13 @@ impl Simulation {
                     .map(
                         |(((((((((p, a), k), o), d), r), on), s), wo), wd)| ForcePart {
                             pairs: p,
-                            active: a,
-                            wake: k,
-                            out: o,
-                            detail: d,
-                            rolling: r,
+                            lists: PairLists {
+                                active: a,
+                                wake: k,
+                                out: o,
+                                detail: d,
+                                rolling: r,
+                            },
                             onsets: on,
                             slots: s,
                             wall_out: wo,
@@ -2164,11 +2163,13 @@ impl Simulation {
             } else {
                 let whole = ForcePart {
                     pairs,
-                    active: pair_active,
-                    wake: pair_wake,
-                    out: pair_out,
-                    detail: pair_detail,
-                    rolling: pair_rolling,
+                    lists: PairLists {
+                        active: pair_active,
+                        wake: pair_wake,
+                        out: pair_out,
+                        detail: pair_detail,
+                        rolling: pair_rolling,
+                    },
                     onsets,
                     slots,
                     wall_out,
