@@ -65,7 +65,8 @@ use batch::{pair_chunk_batched, wall_chunk_batched, Batch, BATCH, BATCH_SCRATCH}
 /// Below this many particles the step runs on the calling thread whatever `threads` says:
 /// a rayon fork-join costs microseconds, as much as the whole step of a small system.
 pub const PARALLEL_MIN_PARTICLES: usize = 256;
-/// Pairs per kernel call (onsets are counted per chunk, to find them without a full scan).
+/// Pairs per kernel call (onsets and ends are counted per chunk, so the onset log and the
+/// gather lists find them without a full scan).
 const PAIR_CHUNK: usize = 256;
 /// The batched pair kernel skips a pair out of contact only while it cannot touch for at
 /// least this many steps at the last step's speed (see [`wake_travel`]).
@@ -394,7 +395,7 @@ pub struct Simulation {
     wall_state: Vec<WallState>,
     /// Contacts begun and ended in each chunk of `PAIR_CHUNK` pairs at the last force
     /// evaluation.
-    chunk_onsets: Vec<Flips>,
+    chunk_flips: Vec<Flips>,
     /// Per block of the particle phase: (largest squared displacement since the last rebuild,
     /// m², largest squared speed, m²/s², any non-finite value, wall onsets).
     chunk_results: Vec<(f64, f64, bool, u32)>,
@@ -525,7 +526,6 @@ fn tangential_force(
     f_t
 }
 
-/// One thread's block of the parallel force phase (see `Simulation::part_cuts`).
 /// Contacts begun (onsets) and ended in one chunk of the pair list at one force evaluation.
 #[derive(Debug, Clone, Copy, Default)]
 struct Flips {
@@ -545,12 +545,13 @@ struct PairLists<'a> {
     rolling: &'a mut [Vec3],
 }
 
+/// One thread's block of the parallel force phase (see `Simulation::part_cuts`).
 struct ForcePart<'a> {
     pairs: &'a mut [PairContact],
     /// The block's pair arrays (cut into chunks for the kernels).
     lists: PairLists<'a>,
     /// Onsets and ends of each of the block's pair chunks.
-    onsets: &'a mut [Flips],
+    flips: &'a mut [Flips],
     slots: &'a mut [WallContact],
     wall_out: &'a mut [WallOut],
     wall_detail: &'a mut [WallDetail],
@@ -1533,7 +1534,7 @@ impl Simulation {
             old_pair_active: Vec::new(),
             old_slots: Vec::new(),
             wall_state: vec![WallState::default(); scene.walls.len()],
-            chunk_onsets: Vec::new(),
+            chunk_flips: Vec::new(),
             chunk_results: Vec::new(),
             contact_force_sum: vec![Vec3::ZERO; n],
             coordination: vec![0; n],
@@ -1669,7 +1670,7 @@ impl Simulation {
     /// chunks of pairs in which a contact began or ended are looked at, and each such pair
     /// is inserted into (or removed from) the sorted lists of its two particles.
     fn sync_active_lists(&mut self) {
-        for (c, flips) in self.chunk_onsets.iter().enumerate() {
+        for (c, flips) in self.chunk_flips.iter().enumerate() {
             if flips.onsets == 0 && flips.ends == 0 {
                 continue;
             }
@@ -2083,12 +2084,12 @@ impl Simulation {
                 (&mut self.pairs, &mut self.pair_out, &self.pair_const);
             let (pair_detail, pair_rolling) = (&mut self.pair_detail, &mut self.pair_rolling);
             let (pair_active, pair_wake) = (&mut self.pair_active, &mut self.pair_wake);
-            let (onsets, slots) = (&mut self.chunk_onsets, &mut self.wall_slots);
+            let (flips, slots) = (&mut self.chunk_flips, &mut self.wall_slots);
             let (wall_out, wall_detail) = (&mut self.wall_out, &mut self.wall_detail);
             let cut = &self.part_cuts;
             let wall_lists = &self.wall_lists;
-            onsets.clear();
-            onsets.resize(pairs.len().div_ceil(PAIR_CHUNK), Flips::default());
+            flips.clear();
+            flips.resize(pairs.len().div_ceil(PAIR_CHUNK), Flips::default());
             let run = |(t, part): (usize, ForcePart<'_>)| {
                 let (first_particle, first_pair) = if t == 0 { (0, 0) } else { cut[t - 1] };
                 let konst = &pair_const[first_pair..first_pair + part.pairs.len()];
@@ -2101,7 +2102,7 @@ impl Simulation {
                     .zip(part.lists.detail.chunks_mut(PAIR_CHUNK))
                     .zip(part.lists.rolling.chunks_mut(PAIR_CHUNK))
                     .zip(konst.chunks(PAIR_CHUNK));
-                for (slot, chunk) in part.onsets.iter_mut().zip(chunks) {
+                for (slot, chunk) in part.flips.iter_mut().zip(chunks) {
                     *slot = kernel(chunk);
                 }
                 let block = match (wall_lists.cuts.get(t), wall_lists.cuts.get(t + 1)) {
@@ -2137,7 +2138,7 @@ impl Simulation {
                     .zip(split_at_cuts(pair_out, &pair_cuts))
                     .zip(split_at_cuts(pair_detail, &pair_cuts))
                     .zip(split_at_cuts(pair_rolling, &pair_cuts))
-                    .zip(split_at_cuts(onsets, &chunk_cuts))
+                    .zip(split_at_cuts(flips, &chunk_cuts))
                     .zip(split_at_cuts(slots, &slot_cuts))
                     .zip(split_at_cuts(wall_out, &slot_cuts))
                     .zip(split_at_cuts(wall_detail, &slot_cuts))
@@ -2151,7 +2152,7 @@ impl Simulation {
                                 detail: d,
                                 rolling: r,
                             },
-                            onsets: on,
+                            flips: on,
                             slots: s,
                             wall_out: wo,
                             wall_detail: wd,
@@ -2170,7 +2171,7 @@ impl Simulation {
                         detail: pair_detail,
                         rolling: pair_rolling,
                     },
-                    onsets,
+                    flips,
                     slots,
                     wall_out,
                     wall_detail,
@@ -2306,8 +2307,8 @@ impl Simulation {
     fn log_onsets(&mut self, walls: bool) {
         let time = self.time;
         let step = self.steps;
-        for (c, count) in self.chunk_onsets.iter().enumerate() {
-            if count.onsets == 0 {
+        for (c, flips) in self.chunk_flips.iter().enumerate() {
+            if flips.onsets == 0 {
                 continue;
             }
             let end = ((c + 1) * PAIR_CHUNK).min(self.pairs.len());

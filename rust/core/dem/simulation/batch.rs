@@ -902,14 +902,14 @@ pub(super) fn pair_chunk_batched<const E: u16, const U: bool>(
     // every pair's law is evaluated by the AVX2 force pass: no per-pair test of the law
     let hertz = c.avx2 && c.pairs_hertz;
     // one law entry and one radius for every pair: written into the batch once per chunk
-    let (mut uniform_reach2, mut uniform_r_sum) = (0.0, 0.0);
+    let mut uniform_r_sum = 0.0;
     if U {
         if let Some((k, r)) = c.pairs_uniform {
             b.fill_uniform(&c.table[k as usize], r);
-            uniform_reach2 = (r + r) * (r + r);
             uniform_r_sum = r + r;
         }
     }
+    let uniform_reach2 = uniform_r_sum * uniform_r_sum;
     let travel = c.travel;
     let (mut onsets, mut ends) = (0u32, 0u32);
     let len = chunk.len();
