@@ -727,6 +727,12 @@ fn pair_in_reach(
 /// rather than turning every few steps.
 #[inline(always)]
 fn wake_travel(travel: f64, dist2: f64, r_sum: f64, min_skip: f64) -> f64 {
+    // within r_sum + 2 min_skip the pair is tested every step: decided without the square
+    // root (a pair at the border may go either way; both are exact)
+    let near = r_sum + 2.0 * min_skip;
+    if dist2 <= near * near {
+        return f64::NEG_INFINITY;
+    }
     let gap = dist2.sqrt() - r_sum;
     let half = 0.5 * (gap * (1.0 - 1e-9) - 64.0 * f64::EPSILON * r_sum);
     if half > min_skip {

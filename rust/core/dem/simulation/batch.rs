@@ -86,9 +86,8 @@ pub(super) struct Batch {
     force: Lanes3,
     /// n × f_t (the torque per unit arm), N.
     torque_per_arm: Lanes3,
+    /// Normal force, N (written on detail steps only).
     f_n: [f64; BATCH],
-    v_n: [f64; BATCH],
-    v_t: Lanes3,
 }
 
 thread_local! {
@@ -120,8 +119,6 @@ impl Batch {
         force: Lanes3::ZERO,
         torque_per_arm: Lanes3::ZERO,
         f_n: [0.0; BATCH],
-        v_n: [0.0; BATCH],
-        v_t: Lanes3::ZERO,
     };
 
     /// Constants of contact `k`, copied while its record is at hand: the Hertz constants
@@ -164,6 +161,21 @@ impl Batch {
             self.r_i[k] = r;
             self.r_j[k] = r;
         }
+    }
+
+    /// Normal and tangential relative speed of contact `k` (m/s): the force pass's operations
+    /// on the batch's inputs, so bitwise its values; for the onset record, made only at onsets
+    /// (the force pass does not store them for every contact).
+    #[inline(always)]
+    fn onset_speeds(&self, k: usize, rotation: bool) -> (f64, f64) {
+        let n = self.n.get(k);
+        let mut v_rel = self.v_rel.get(k);
+        if rotation {
+            v_rel += self.spin.get(k).cross(n);
+        }
+        let v_n = v_rel.dot(n);
+        let v_t = v_rel - v_n * n;
+        (v_n, v_t.length())
     }
 
     /// Law values of the contacts whose law is pending (see [`Batch::set_constants`]).
@@ -213,14 +225,22 @@ fn pair_geometry<const E: u16>(b: &mut Batch, c: &PairCtx<'_>) {
 /// Force pass of a batch: normal force with damping and clamp, Mindlin tangential force with
 /// the Coulomb cap, n × f_t; the operations of [`pair_kernel`] and [`wall_kernel`] in their
 /// order (the scalar loop here, the AVX2 build in `avx2_forces` with selects for branches).
+/// `all_hertz`: every lane's `hertz` mask is set (the AVX2 pass then skips the masks).
 #[inline(always)]
-fn contact_forces<const E: u16>(b: &mut Batch, c: &PairCtx<'_>) {
+fn contact_forces<const E: u16>(b: &mut Batch, c: &PairCtx<'_>, all_hertz: bool) {
     #[cfg(target_arch = "x86_64")]
     if c.avx2 {
         // SAFETY: `avx2` is set only when the CPU reported AVX2.
-        unsafe { avx2_forces::contact_forces::<E>(b, c) };
+        unsafe {
+            if all_hertz {
+                avx2_forces::contact_forces::<E, true>(b, c)
+            } else {
+                avx2_forces::contact_forces::<E, false>(b, c)
+            }
+        };
         return;
     }
+    let _ = all_hertz;
     let rotation = on::<E>(c.effects, Effect::Rotation);
     let friction = on::<E>(c.effects, Effect::Friction);
     let (clamp, dt) = (c.clamp, c.dt);
@@ -258,9 +278,9 @@ fn contact_forces<const E: u16>(b: &mut Batch, c: &PairCtx<'_>) {
         }
         b.force.set(k, force);
         b.torque_per_arm.set(k, torque_per_arm);
-        b.f_n[k] = f_n;
-        b.v_n[k] = v_n;
-        b.v_t.set(k, v_t);
+        if c.detail {
+            b.f_n[k] = f_n;
+        }
     }
 }
 
@@ -713,7 +733,8 @@ mod avx2_forces {
         detail: &mut [WallDetail],
         b: &mut Batch,
     ) {
-        contact_forces::<E>(b, &c.shared);
+        // every lane of a plane group holds Hertz constants
+        contact_forces::<E, true>(b, &c.shared);
         let stride = c.wall_stride;
         let moving = on::<E>(c.shared.effects, Effect::MovingWalls);
         for (gi, &(g, q, m)) in groups.iter().enumerate() {
@@ -761,7 +782,7 @@ mod avx2_forces {
                     }
                 }
                 let o = (!full).then(|| &mut out[slot]);
-                scatter_wall_lane(b, k, s, o, d, c.shared.detail);
+                scatter_wall_lane::<E>(b, k, s, o, d, &c.shared);
             }
         }
     }
@@ -796,7 +817,10 @@ mod avx2_forces {
     }
 
     #[target_feature(enable = "avx2")]
-    pub(super) unsafe fn contact_forces<const E: u16>(b: &mut Batch, c: &PairCtx<'_>) {
+    pub(super) unsafe fn contact_forces<const E: u16, const H: bool>(
+        b: &mut Batch,
+        c: &PairCtx<'_>,
+    ) {
         let rotation = on::<E>(c.effects, Effect::Rotation);
         let friction = on::<E>(c.effects, Effect::Friction);
         let damping = on::<E>(c.effects, Effect::Damping);
@@ -814,20 +838,30 @@ mod avx2_forces {
             }
             let v_n = dot(v_rel, n);
             let v_t = sub(v_rel, scale(v_n, n));
-            // the Hertz law where the lanes hold its constants (`law_at`'s operations)
-            let hertz =
-                _mm256_castsi256_pd(_mm256_loadu_si256(b.hertz.as_ptr().add(k) as *const __m256i));
+            // the Hertz law where the lanes hold its constants (`law_at`'s operations; with
+            // `H`, every lane does)
             let overlap = ld(&b.overlap, k);
             let sq = _mm256_sqrt_pd(overlap);
             let (f_el, c_n, k_t) = (ld(&b.f_el, k), ld(&b.c_n, k), ld(&b.k_t, k));
-            let f_el =
-                _mm256_blendv_pd(f_el, _mm256_mul_pd(_mm256_mul_pd(f_el, sq), overlap), hertz);
-            let c_n = if damping {
-                _mm256_blendv_pd(c_n, _mm256_mul_pd(c_n, _mm256_sqrt_pd(sq)), hertz)
+            let hertz_f_el = _mm256_mul_pd(_mm256_mul_pd(f_el, sq), overlap);
+            let hertz_c_n = if damping {
+                _mm256_mul_pd(c_n, _mm256_sqrt_pd(sq))
             } else {
-                _mm256_andnot_pd(hertz, c_n)
+                zero
             };
-            let k_t = _mm256_blendv_pd(k_t, _mm256_mul_pd(k_t, sq), hertz);
+            let hertz_k_t = _mm256_mul_pd(k_t, sq);
+            let (f_el, c_n, k_t) = if H {
+                (hertz_f_el, hertz_c_n, hertz_k_t)
+            } else {
+                let hertz = _mm256_castsi256_pd(_mm256_loadu_si256(
+                    b.hertz.as_ptr().add(k) as *const __m256i
+                ));
+                (
+                    _mm256_blendv_pd(f_el, hertz_f_el, hertz),
+                    _mm256_blendv_pd(c_n, hertz_c_n, hertz),
+                    _mm256_blendv_pd(k_t, hertz_k_t, hertz),
+                )
+            };
             let mut f_n = _mm256_add_pd(f_el, _mm256_mul_pd(c_n, v_n));
             if c.clamp {
                 // f_n < 0 → 0 (NaN stays)
@@ -850,16 +884,23 @@ mod avx2_forces {
                 let f_stick = sub(scale(_mm256_xor_pd(k_t, sign), xi), scale(c_t, v_t));
                 let f2 = dot(f_stick, f_stick);
                 let sliding = _mm256_cmp_pd::<_CMP_GT_OQ>(f2, _mm256_mul_pd(cap, cap));
-                let f_slide = scale(_mm256_div_pd(cap, _mm256_sqrt_pd(f2)), f_stick);
-                let inv = _mm256_div_pd(minus_one, k_t);
-                let stiff = _mm256_cmp_pd::<_CMP_GT_OQ>(k_t, zero);
-                let xi_slide = V4 {
-                    x: _mm256_and_pd(_mm256_mul_pd(f_slide.x, inv), stiff),
-                    y: _mm256_and_pd(_mm256_mul_pd(f_slide.y, inv), stiff),
-                    z: _mm256_and_pd(_mm256_mul_pd(f_slide.z, inv), stiff),
+                let f_t = if _mm256_movemask_pd(sliding) == 0 {
+                    // no lane slides (the usual case between particles of a pack): the
+                    // cone's square root and two divisions are not needed
+                    store(&mut b.history, k, xi);
+                    f_stick
+                } else {
+                    let f_slide = scale(_mm256_div_pd(cap, _mm256_sqrt_pd(f2)), f_stick);
+                    let inv = _mm256_div_pd(minus_one, k_t);
+                    let stiff = _mm256_cmp_pd::<_CMP_GT_OQ>(k_t, zero);
+                    let xi_slide = V4 {
+                        x: _mm256_and_pd(_mm256_mul_pd(f_slide.x, inv), stiff),
+                        y: _mm256_and_pd(_mm256_mul_pd(f_slide.y, inv), stiff),
+                        z: _mm256_and_pd(_mm256_mul_pd(f_slide.z, inv), stiff),
+                    };
+                    store(&mut b.history, k, select(sliding, xi_slide, xi));
+                    select(sliding, f_slide, f_stick)
                 };
-                let f_t = select(sliding, f_slide, f_stick);
-                store(&mut b.history, k, select(sliding, xi_slide, xi));
                 force = add(force, f_t);
                 if rotation {
                     torque_per_arm = cross(n, f_t);
@@ -867,9 +908,9 @@ mod avx2_forces {
             }
             store(&mut b.force, k, force);
             store(&mut b.torque_per_arm, k, torque_per_arm);
-            st(&mut b.f_n, k, f_n);
-            st(&mut b.v_n, k, v_n);
-            store(&mut b.v_t, k, v_t);
+            if c.detail {
+                st(&mut b.f_n, k, f_n);
+            }
             k += 4;
         }
     }
@@ -978,7 +1019,7 @@ pub(super) fn pair_chunk_batched<const E: u16, const U: bool>(
         if pending {
             b.set_laws::<E>(c, |e| c.table[konst[e] as usize]);
         }
-        contact_forces::<E>(b, c);
+        contact_forces::<E>(b, c, hertz);
         // ---- scatter
         for k in 0..b.len {
             let e = b.index[k] as usize;
@@ -991,8 +1032,7 @@ pub(super) fn pair_chunk_batched<const E: u16, const U: bool>(
             let d = &mut detail[e];
             if onset {
                 onsets += 1;
-                d.onset_normal_speed = b.v_n[k];
-                d.onset_tangential_speed = b.v_t.get(k).length();
+                (d.onset_normal_speed, d.onset_tangential_speed) = b.onset_speeds(k, rotation);
             }
             if c.detail {
                 d.normal = n;
@@ -1078,12 +1118,12 @@ pub(super) fn wall_chunk_batched<const E: u16>(
         if pending {
             b.set_laws::<E>(&c.shared, |q| c.shared.table[slots[q].k as usize]);
         }
-        contact_forces::<E>(b, &c.shared);
+        contact_forces::<E>(b, &c.shared, false);
         // ---- scatter
         for k in 0..b.len {
             let q = b.index[k] as usize;
             let d = &mut detail[q];
-            scatter_wall_lane(b, k, &mut slots[q], Some(&mut out[q]), d, c.shared.detail);
+            scatter_wall_lane::<E>(b, k, &mut slots[q], Some(&mut out[q]), d, &c.shared);
         }
     }
 }
@@ -1092,21 +1132,21 @@ pub(super) fn wall_chunk_batched<const E: u16>(
 /// speeds, the force and torque (unless `out` is `None`: the caller wrote them as rows) and,
 /// on detail steps, the record values.
 #[inline(always)]
-fn scatter_wall_lane(
+fn scatter_wall_lane<const E: u16>(
     b: &Batch,
     k: usize,
     s: &mut WallContact,
     out: Option<&mut WallOut>,
     d: &mut WallDetail,
-    detail: bool,
+    c: &PairCtx<'_>,
 ) {
+    let (detail, rotation) = (c.detail, on::<E>(c.effects, Effect::Rotation));
     let onset = !s.active;
     s.active = true;
     s.onset = onset;
     s.history = b.history.get(k);
     if onset {
-        d.onset_normal_speed = b.v_n[k];
-        d.onset_tangential_speed = b.v_t.get(k).length();
+        (d.onset_normal_speed, d.onset_tangential_speed) = b.onset_speeds(k, rotation);
     }
     if let Some(o) = out {
         let arm = b.arm[k];
