@@ -1323,7 +1323,7 @@ fn particle_chunk<const E: u16>(
         #[cfg(target_arch = "x86_64")]
         if c.avx2 && k + 4 <= len && alive[k..k + 4].iter().all(|&a| a) {
             // four particles: gathered one by one, advanced four per instruction
-            let mut ft = [[0.0; 4]; 6];
+            let (mut fs, mut ts) = ([Vec3::ZERO; 4], [Vec3::ZERO; 4]);
             for l in 0..4 {
                 let (f, t, z, zw, onsets) = gather(k + l);
                 wall_onsets += onsets;
@@ -1332,14 +1332,13 @@ fn particle_chunk<const E: u16>(
                     coordination[k + l] = z;
                     wall_coordination[k + l] = zw;
                 }
-                for (q, value) in [f.x, f.y, f.z, t.x, t.y, t.z].into_iter().enumerate() {
-                    ft[q][l] = value;
-                }
+                (fs[l], ts[l]) = (f, t);
             }
             // SAFETY: `avx2` is set only when the CPU reported AVX2.
             let (disp2, v2, p) = unsafe {
                 batch::advance4::<E>(
-                    &ft,
+                    fs,
+                    ts,
                     &mut position[k..k + 4],
                     &mut velocity[k..k + 4],
                     &mut omega[k..k + 4],

@@ -419,15 +419,17 @@ mod avx2_forces {
     }
 
     /// The leapfrog update of four consecutive alive particles, four per instruction: the
-    /// operations of the particle phase's update, in its order, on each lane. `ft` holds
-    /// the lanes of the force and torque (x, y, z of each). Returns the largest squared
+    /// operations of the particle phase's update, in its order, on each lane. `fs`, `ts`:
+    /// the four forces (N) and torques (N·m), made into lanes in registers (a vector load
+    /// of values just stored one by one would wait for the stores). Returns the largest squared
     /// displacement from `reference` (a NaN one is ignored, as by the scalar update) and the
     /// finiteness probe (0, or NaN when a value is not finite).
     #[target_feature(enable = "avx2")]
     #[inline]
     #[allow(clippy::too_many_arguments)]
     pub(in crate::dem::simulation) unsafe fn advance4<const E: u16>(
-        ft: &[[f64; 4]; 6],
+        fs: [Vec3; 4],
+        ts: [Vec3; 4],
         x: &mut [Vec3],
         v: &mut [Vec3],
         w: &mut [Vec3],
@@ -445,12 +447,12 @@ mod avx2_forces {
             (&reference[..4], &inv_mass[..4], &inv_inertia[..4]);
         let zero = _mm256_setzero_pd();
         let dt = _mm256_set1_pd(dt);
-        let lane = |q: usize| _mm256_loadu_pd(ft[q].as_ptr());
-        let f = V4 {
-            x: lane(0),
-            y: lane(1),
-            z: lane(2),
+        let lanes4 = |v: [Vec3; 4]| V4 {
+            x: _mm256_setr_pd(v[0].x, v[1].x, v[2].x, v[3].x),
+            y: _mm256_setr_pd(v[0].y, v[1].y, v[2].y, v[3].y),
+            z: _mm256_setr_pd(v[0].z, v[1].z, v[2].z, v[3].z),
         };
+        let f = lanes4(fs);
         let g = V4 {
             x: _mm256_set1_pd(gravity.x),
             y: _mm256_set1_pd(gravity.y),
@@ -465,11 +467,7 @@ mod avx2_forces {
         let s = add(x_new, v_new);
         let mut probe = _mm256_mul_pd(_mm256_add_pd(_mm256_add_pd(s.x, s.y), s.z), zero);
         if rotation {
-            let t = V4 {
-                x: lane(3),
-                y: lane(4),
-                z: lane(5),
-            };
+            let t = lanes4(ts);
             // ω + T (I⁻¹ Δt)
             let k = _mm256_mul_pd(_mm256_loadu_pd(inv_inertia.as_ptr()), dt);
             let mut w_new = add(load_aos4(w.as_ptr()), scale(k, t));
@@ -758,6 +756,21 @@ mod avx2_forces {
                         out.as_mut_ptr().add((g as usize + l) * stride + q as usize) as *mut f64;
                     _mm256_storeu_pd(dst, lo[l]);
                     _mm_storeu_pd(dst.add(4), hi[l]);
+                }
+                // four contacts that go on (the common case): `scatter_wall_lane` has only
+                // the spring and the cleared onset to write, as rows
+                let row = |l: usize| (g as usize + l) * stride + q as usize;
+                if !c.shared.detail && (0..4).all(|l| slots[row(l)].active) {
+                    let h = load(&b.history, 4 * gi);
+                    let rows = transpose(h.x, h.y, h.z, h.z);
+                    for (l, r) in rows.into_iter().enumerate() {
+                        let s = &mut slots[row(l)];
+                        s.onset = false;
+                        let dst = &mut s.history.x as *mut f64;
+                        _mm_storeu_pd(dst, _mm256_castpd256_pd128(r));
+                        _mm_store_sd(dst.add(2), _mm256_extractf128_pd::<1>(r));
+                    }
+                    continue;
                 }
             }
             for l in 0..4 {
