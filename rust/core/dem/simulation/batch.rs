@@ -800,6 +800,52 @@ mod avx2_forces {
         }
     }
 
+    /// The scatter of four pairs of a batch (lanes `k..k + 4`) that were in contact and go
+    /// on, on a step without records: their springs, their outputs and their cleared onsets,
+    /// written as rows from the lanes (that of `pair_chunk_batched`'s scatter, whose
+    /// remaining writes are all for onsets and records).
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub(super) unsafe fn pair_rows(
+        b: &Batch,
+        k: usize,
+        chunk: &mut [PairContact],
+        out: &mut [PairOut],
+    ) {
+        let h = load(&b.history, k);
+        let f = load(&b.force, k);
+        let t = load(&b.torque_per_arm, k);
+        let overlap = ld(&b.overlap, k);
+        // (a, c) of lanes 0 and 2, and of lanes 1 and 3: in-lane shuffles only
+        let pairs = |a: __m256d, c: __m256d| (_mm256_unpacklo_pd(a, c), _mm256_unpackhi_pd(a, c));
+        let (hxy, hz) = (pairs(h.x, h.y), pairs(h.z, h.z));
+        let (fxy, fz_tx, tyz) = (pairs(f.x, f.y), pairs(f.z, t.x), pairs(t.y, t.z));
+        let ov = pairs(overlap, overlap);
+        // lane l's two values
+        let row = |v: (__m256d, __m256d), l: usize| {
+            let v = if l & 1 == 0 { v.0 } else { v.1 };
+            if l < 2 {
+                _mm256_castpd256_pd128(v)
+            } else {
+                _mm256_extractf128_pd::<1>(v)
+            }
+        };
+        for l in 0..4 {
+            let e = b.index[k + l] as usize;
+            let p = &mut chunk[e];
+            p.onset = false;
+            let dst = &mut p.history.x as *mut f64;
+            _mm_storeu_pd(dst, row(hxy, l));
+            _mm_store_sd(dst.add(2), row(hz, l));
+            // force, torque per arm, overlap: 7 f64 from the start of the row
+            let o = &mut out[e] as *mut PairOut as *mut f64;
+            _mm_storeu_pd(o, row(fxy, l));
+            _mm_storeu_pd(o.add(2), row(fz_tx, l));
+            _mm_storeu_pd(o.add(4), row(tyz, l));
+            _mm_store_sd(o.add(6), row(ov, l));
+        }
+    }
+
     #[target_feature(enable = "avx2")]
     pub(super) unsafe fn pair_geometry<const E: u16>(b: &mut Batch, c: &PairCtx<'_>) {
         let rotation = on::<E>(c.effects, Effect::Rotation);
@@ -929,7 +975,7 @@ mod avx2_forces {
     }
 }
 
-// The layouts `plane_slots` reads and writes whole rows of.
+// The layouts `plane_slots` and `pair_rows` read and write whole rows of.
 const _: () = {
     use std::mem::{offset_of, size_of};
     assert!(size_of::<Vec3>() == 24 && offset_of!(Vec3, y) == 8 && offset_of!(Vec3, z) == 16);
@@ -938,6 +984,8 @@ const _: () = {
     assert!(offset_of!(ContactConst, ct_ratio) == offset_of!(ContactConst, f_el) + 24);
     assert!(size_of::<WallOut>() == 48 && offset_of!(WallOut, torque) == 24);
     assert!(size_of::<WallContact>() == 40 && size_of::<PairContact>() == 48);
+    assert!(size_of::<PairOut>() == 64 && offset_of!(PairOut, force) == 0);
+    assert!(offset_of!(PairOut, torque_per_arm) == 24 && offset_of!(PairOut, overlap) == 48);
 };
 
 /// The pairs of one chunk in batches (see [`Batch`]); returns the number of onsets. `U`:
@@ -1034,7 +1082,19 @@ pub(super) fn pair_chunk_batched<const E: u16, const U: bool>(
         }
         contact_forces::<E>(b, c, hertz);
         // ---- scatter
-        for k in 0..b.len {
+        let mut k = 0;
+        while k < b.len {
+            #[cfg(target_arch = "x86_64")]
+            if c.avx2
+                && !c.detail
+                && k + 4 <= b.len
+                && (0..4).all(|l| active.get(b.index[k + l] as usize) == Some(&true))
+            {
+                // SAFETY: `avx2` is set only when the CPU reported AVX2.
+                unsafe { avx2_forces::pair_rows(b, k, chunk, out) };
+                k += 4;
+                continue;
+            }
             let e = b.index[k] as usize;
             let p = &mut chunk[e];
             let onset = !active[e];
@@ -1056,6 +1116,7 @@ pub(super) fn pair_chunk_batched<const E: u16, const U: bool>(
                 torque_per_arm: b.torque_per_arm.get(k),
                 overlap: b.overlap[k],
             };
+            k += 1;
         }
     }
     Flips { onsets, ends }
