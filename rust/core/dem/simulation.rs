@@ -603,17 +603,27 @@ fn join_parts<T: Send, F: Fn(T) + Sync>(mut parts: std::vec::IntoIter<T>, run: &
 }
 
 /// `s` cut at the ascending positions `cuts` into `cuts.len() + 1` consecutive pieces.
-fn split_at_cuts<'a, T>(mut s: &'a mut [T], cuts: &[usize]) -> Vec<&'a mut [T]> {
-    let mut out = Vec::with_capacity(cuts.len() + 1);
+/// An iterator, not a collection: the parallel step cuts a dozen arrays every step, and
+/// allocating for each showed in its profile.
+fn split_at_cuts<'a, T>(
+    s: &'a mut [T],
+    cuts: &'a [usize],
+) -> impl Iterator<Item = &'a mut [T]> + 'a {
+    let mut rest = Some(s);
     let mut at = 0;
-    for &c in cuts {
-        let (head, tail) = s.split_at_mut(c - at);
-        out.push(head);
-        s = tail;
-        at = c;
-    }
-    out.push(s);
-    out
+    let mut cuts = cuts.iter();
+    std::iter::from_fn(move || {
+        let s = rest.take()?;
+        match cuts.next() {
+            Some(&c) => {
+                let (head, tail) = s.split_at_mut(c - at);
+                at = c;
+                rest = Some(tail);
+                Some(head)
+            }
+            None => Some(s),
+        }
+    })
 }
 
 /// Whether the step may use its AVX2 build: the CPU has AVX2 and `DEMFEM_NO_AVX2` is unset
@@ -2137,7 +2147,6 @@ impl Simulation {
                     pair_cuts.iter().map(|e| e.div_ceil(PAIR_CHUNK)).collect();
                 let slot_cuts: Vec<usize> = cut.iter().map(|c| c.0 * stride).collect();
                 let parts: Vec<_> = split_at_cuts(pairs, &pair_cuts)
-                    .into_iter()
                     .zip(split_at_cuts(pair_active, &pair_cuts))
                     .zip(split_at_cuts(pair_wake, &pair_cuts))
                     .zip(split_at_cuts(pair_out, &pair_cuts))
@@ -2213,7 +2222,6 @@ impl Simulation {
                 self.chunk_results.clear();
                 self.chunk_results.resize(n_parts, (0.0, 0.0, false, 0));
                 let parts: Vec<_> = split_at_cuts(&mut self.position, &cuts)
-                    .into_iter()
                     .zip(split_at_cuts(&mut self.velocity, &cuts))
                     .zip(split_at_cuts(&mut self.omega, &cuts))
                     .zip(split_at_cuts(&mut self.contact_force_sum, &cuts))
