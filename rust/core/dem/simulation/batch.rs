@@ -163,18 +163,25 @@ impl Batch {
         }
     }
 
-    /// Normal and tangential relative speed of contact `k` (m/s): the force pass's operations
-    /// on the batch's inputs, so bitwise its values; for the onset record, made only at onsets
-    /// (the force pass does not store them for every contact).
+    /// Normal n, normal relative speed v_n (m/s) and tangential relative velocity v_t (m/s)
+    /// of contact `k` from the batch's inputs: the force pass's first operations.
     #[inline(always)]
-    fn onset_speeds(&self, k: usize, rotation: bool) -> (f64, f64) {
+    fn relative_velocity(&self, k: usize, rotation: bool) -> (Vec3, f64, Vec3) {
         let n = self.n.get(k);
         let mut v_rel = self.v_rel.get(k);
         if rotation {
             v_rel += self.spin.get(k).cross(n);
         }
         let v_n = v_rel.dot(n);
-        let v_t = v_rel - v_n * n;
+        (n, v_n, v_rel - v_n * n)
+    }
+
+    /// Normal and tangential relative speed of contact `k` (m/s), bitwise the force pass's
+    /// values; for the onset record, made only at onsets (the force pass does not store them
+    /// for every contact).
+    #[inline(always)]
+    fn onset_speeds(&self, k: usize, rotation: bool) -> (f64, f64) {
+        let (_, v_n, v_t) = self.relative_velocity(k, rotation);
         (v_n, v_t.length())
     }
 
@@ -245,13 +252,7 @@ fn contact_forces<const E: u16>(b: &mut Batch, c: &PairCtx<'_>, all_hertz: bool)
     let friction = on::<E>(c.effects, Effect::Friction);
     let (clamp, dt) = (c.clamp, c.dt);
     for k in 0..b.len.min(BATCH) {
-        let n = b.n.get(k);
-        let mut v_rel = b.v_rel.get(k);
-        if rotation {
-            v_rel += b.spin.get(k).cross(n);
-        }
-        let v_n = v_rel.dot(n);
-        let v_t = v_rel - v_n * n;
+        let (n, v_n, v_t) = b.relative_velocity(k, rotation);
         let c_n = b.c_n[k];
         let mut f_n = b.f_el[k] + c_n * v_n;
         if clamp && f_n < 0.0 {
