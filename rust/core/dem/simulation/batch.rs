@@ -499,6 +499,34 @@ mod avx2_forces {
         (max, max_v2, (p[0] + p[1]) + (p[2] + p[3]))
     }
 
+    /// (a, c) of lanes 0 and 2, and of lanes 1 and 3: in-lane shuffles only (cheap where a
+    /// 256-bit operation runs as two 128-bit halves).
+    #[inline(always)]
+    unsafe fn lane_pairs(a: __m256d, c: __m256d) -> (__m256d, __m256d) {
+        (_mm256_unpacklo_pd(a, c), _mm256_unpackhi_pd(a, c))
+    }
+
+    /// Lane l's two values (a_l, c_l) of `lane_pairs(a, c)`.
+    #[inline(always)]
+    unsafe fn lane_pair(v: (__m256d, __m256d), l: usize) -> __m128d {
+        let v = if l & 1 == 0 { v.0 } else { v.1 };
+        if l < 2 {
+            _mm256_castpd256_pd128(v)
+        } else {
+            _mm256_extractf128_pd::<1>(v)
+        }
+    }
+
+    /// Lane l of `v` written as three f64 at `dst[l]` (a 16-byte and an 8-byte store).
+    #[inline(always)]
+    unsafe fn store_rows3(v: V4, dst: [*mut f64; 4]) {
+        let (xy, zz) = (lane_pairs(v.x, v.y), lane_pairs(v.z, v.z));
+        for (l, d) in dst.into_iter().enumerate() {
+            _mm_storeu_pd(d, lane_pair(xy, l));
+            _mm_store_sd(d.add(2), lane_pair(zz, l));
+        }
+    }
+
     /// The lanes of `v` as an array.
     #[inline(always)]
     unsafe fn lanes(v: __m256d) -> [f64; 4] {
@@ -762,15 +790,13 @@ mod avx2_forces {
                 // the spring and the cleared onset to write, as rows
                 let row = |l: usize| (g as usize + l) * stride + q as usize;
                 if !c.shared.detail && (0..4).all(|l| slots[row(l)].active) {
-                    let h = load(&b.history, 4 * gi);
-                    let rows = transpose(h.x, h.y, h.z, h.z);
-                    for (l, r) in rows.into_iter().enumerate() {
+                    let mut dst = [std::ptr::null_mut(); 4];
+                    for (l, d) in dst.iter_mut().enumerate() {
                         let s = &mut slots[row(l)];
                         s.onset = false;
-                        let dst = &mut s.history.x as *mut f64;
-                        _mm_storeu_pd(dst, _mm256_castpd256_pd128(r));
-                        _mm_store_sd(dst.add(2), _mm256_extractf128_pd::<1>(r));
+                        *d = &mut s.history.x as *mut f64;
                     }
+                    store_rows3(load(&b.history, 4 * gi), dst);
                     continue;
                 }
             }
@@ -813,38 +839,26 @@ mod avx2_forces {
         chunk: &mut [PairContact],
         out: &mut [PairOut],
     ) {
-        let h = load(&b.history, k);
         let f = load(&b.force, k);
         let t = load(&b.torque_per_arm, k);
         let overlap = ld(&b.overlap, k);
-        // (a, c) of lanes 0 and 2, and of lanes 1 and 3: in-lane shuffles only
-        let pairs = |a: __m256d, c: __m256d| (_mm256_unpacklo_pd(a, c), _mm256_unpackhi_pd(a, c));
-        let (hxy, hz) = (pairs(h.x, h.y), pairs(h.z, h.z));
-        let (fxy, fz_tx, tyz) = (pairs(f.x, f.y), pairs(f.z, t.x), pairs(t.y, t.z));
-        let ov = pairs(overlap, overlap);
-        // lane l's two values
-        let row = |v: (__m256d, __m256d), l: usize| {
-            let v = if l & 1 == 0 { v.0 } else { v.1 };
-            if l < 2 {
-                _mm256_castpd256_pd128(v)
-            } else {
-                _mm256_extractf128_pd::<1>(v)
-            }
-        };
-        for l in 0..4 {
+        let (fxy, fz_tx) = (lane_pairs(f.x, f.y), lane_pairs(f.z, t.x));
+        let (tyz, ov) = (lane_pairs(t.y, t.z), lane_pairs(overlap, overlap));
+        // (a loop, not `array::map`: a closure passed on loses the AVX2 build)
+        let mut dst = [std::ptr::null_mut(); 4];
+        for (l, d) in dst.iter_mut().enumerate() {
             let e = b.index[k + l] as usize;
             let p = &mut chunk[e];
             p.onset = false;
-            let dst = &mut p.history.x as *mut f64;
-            _mm_storeu_pd(dst, row(hxy, l));
-            _mm_store_sd(dst.add(2), row(hz, l));
             // force, torque per arm, overlap: 7 f64 from the start of the row
             let o = &mut out[e] as *mut PairOut as *mut f64;
-            _mm_storeu_pd(o, row(fxy, l));
-            _mm_storeu_pd(o.add(2), row(fz_tx, l));
-            _mm_storeu_pd(o.add(4), row(tyz, l));
-            _mm_store_sd(o.add(6), row(ov, l));
+            _mm_storeu_pd(o, lane_pair(fxy, l));
+            _mm_storeu_pd(o.add(2), lane_pair(fz_tx, l));
+            _mm_storeu_pd(o.add(4), lane_pair(tyz, l));
+            _mm_store_sd(o.add(6), lane_pair(ov, l));
+            *d = &mut p.history.x as *mut f64;
         }
+        store_rows3(load(&b.history, k), dst);
     }
 
     #[target_feature(enable = "avx2")]
@@ -1102,14 +1116,13 @@ pub(super) fn pair_chunk_batched<const E: u16, const U: bool>(
             active[e] = true;
             p.onset = onset;
             p.history = b.history.get(k);
-            let n = b.n.get(k);
             let d = &mut detail[e];
             if onset {
                 onsets += 1;
                 (d.onset_normal_speed, d.onset_tangential_speed) = b.onset_speeds(k, rotation);
             }
             if c.detail {
-                d.normal = n;
+                d.normal = b.n.get(k);
                 d.normal_force = b.f_n[k];
             }
             out[e] = PairOut {
