@@ -1177,6 +1177,80 @@ fn wall_chunk<const E: u16>(
 }
 
 /// What the particle phase reads to sum the forces on a particle (see [`Gather::particle`]).
+/// A running sum of vectors (glam's `+=`, component by component). On x86_64 it keeps x
+/// and y in one SSE2 register and z apart: left to itself, LLVM packs the gather's force and
+/// torque sums into 256-bit shapes that need a lane-crossing `vpermpd` per contact (3 µops
+/// on first-generation Zen).
+#[derive(Clone, Copy)]
+struct Sum3 {
+    #[cfg(target_arch = "x86_64")]
+    xy: std::arch::x86_64::__m128d,
+    #[cfg(not(target_arch = "x86_64"))]
+    xy: (f64, f64),
+    z: f64,
+}
+
+impl Sum3 {
+    #[inline(always)]
+    fn zero() -> Self {
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: SSE2 is part of the x86_64 baseline.
+        let xy = unsafe { std::arch::x86_64::_mm_setzero_pd() };
+        #[cfg(not(target_arch = "x86_64"))]
+        let xy = (0.0, 0.0);
+        Sum3 { xy, z: 0.0 }
+    }
+
+    /// Adds s v, formed as glam's `v * s` (each component times s; the product commutes).
+    #[inline(always)]
+    fn add_scaled(&mut self, s: f64, v: Vec3) {
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: SSE2 is part of the x86_64 baseline.
+        unsafe {
+            use std::arch::x86_64::*;
+            let p = _mm_mul_pd(_mm_setr_pd(v.x, v.y), _mm_set1_pd(s));
+            self.xy = _mm_add_pd(self.xy, p);
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            self.xy = (self.xy.0 + v.x * s, self.xy.1 + v.y * s);
+        }
+        self.z += v.z * s;
+    }
+
+    /// Adds v.
+    #[inline(always)]
+    fn add(&mut self, v: Vec3) {
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: SSE2 is part of the x86_64 baseline.
+        unsafe {
+            use std::arch::x86_64::*;
+            self.xy = _mm_add_pd(self.xy, _mm_setr_pd(v.x, v.y));
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            self.xy = (self.xy.0 + v.x, self.xy.1 + v.y);
+        }
+        self.z += v.z;
+    }
+
+    #[inline(always)]
+    fn get(self) -> Vec3 {
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: SSE2 is part of the x86_64 baseline.
+        let (x, y) = unsafe {
+            use std::arch::x86_64::*;
+            (
+                _mm_cvtsd_f64(self.xy),
+                _mm_cvtsd_f64(_mm_unpackhi_pd(self.xy, self.xy)),
+            )
+        };
+        #[cfg(not(target_arch = "x86_64"))]
+        let (x, y) = self.xy;
+        Vec3::new(x, y, self.z)
+    }
+}
+
 struct Gather<'a> {
     c: &'a ParticleCtx<'a>,
     /// The chunk's slices (index k = particle − first).
@@ -1210,8 +1284,8 @@ impl Gather<'_> {
         let rotation = on::<E>(c.effects, Effect::Rotation);
         let rolling = on::<E>(c.effects, Effect::RollingResistance);
         let planar = on::<E>(c.effects, Effect::Planar);
-        let mut f = Vec3::ZERO;
-        let mut t = Vec3::ZERO;
+        let mut f = Sum3::zero();
+        let mut t = Sum3::zero();
         let mut z = 0u32;
         // the pairs in contact in increasing index order (those where the particle is j
         // first, as their i is smaller); the force on i is +force, on j −force: added times
@@ -1229,12 +1303,12 @@ impl Gather<'_> {
             // +1.0 for the first particle (a odd), −1.0 for the second: the sign bit
             let sign = f64::from_bits(1.0f64.to_bits() | (u64::from(!a & 1) << 63));
             z += 1;
-            f += p.force * sign;
+            f.add_scaled(sign, p.force);
             if rotation {
                 let arm = radius[k] - 0.5 * p.overlap;
-                t += arm * p.torque_per_arm;
+                t.add_scaled(arm, p.torque_per_arm);
                 if rolling {
-                    t += pair_rolling[e] * sign;
+                    t.add_scaled(sign, pair_rolling[e]);
                 }
             }
         }
@@ -1254,11 +1328,11 @@ impl Gather<'_> {
                 if s.onset {
                     onsets += 1;
                 }
-                f += o.force;
-                t += o.torque;
+                f.add(o.force);
+                t.add(o.torque);
             }
         }
-        (f, t, z, zw, onsets)
+        (f.get(), t.get(), z, zw, onsets)
     }
 }
 
@@ -1333,17 +1407,24 @@ fn particle_chunk<const E: u16>(
         #[cfg(target_arch = "x86_64")]
         if c.avx2 && k + 4 <= len && alive[k..k + 4].iter().all(|&a| a) {
             // four particles: gathered one by one, advanced four per instruction
-            let (mut fs, mut ts) = ([Vec3::ZERO; 4], [Vec3::ZERO; 4]);
-            for l in 0..4 {
-                let (f, t, z, zw, onsets) = gather(k + l);
-                wall_onsets += onsets;
-                if c.detail {
-                    force_sum[k + l] = f;
-                    coordination[k + l] = z;
-                    wall_coordination[k + l] = zw;
-                }
-                (fs[l], ts[l]) = (f, t);
+            macro_rules! one {
+                ($l:expr) => {{
+                    let (f, t, z, zw, onsets) = gather(k + $l);
+                    wall_onsets += onsets;
+                    if c.detail {
+                        force_sum[k + $l] = f;
+                        coordination[k + $l] = z;
+                        wall_coordination[k + $l] = zw;
+                    }
+                    (f, t)
+                }};
             }
+            // written out four times, not a loop over an array: the sums stay in registers
+            // (an array filled in a loop goes through the stack, and its reload as lanes
+            // waits on the stores)
+            let ((f0, t0), (f1, t1)) = (one!(0), one!(1));
+            let ((f2, t2), (f3, t3)) = (one!(2), one!(3));
+            let (fs, ts) = ([f0, f1, f2, f3], [t0, t1, t2, t3]);
             // SAFETY: `avx2` is set only when the CPU reported AVX2.
             let (disp2, v2, p) = unsafe {
                 batch::advance4::<E>(
