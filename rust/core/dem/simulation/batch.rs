@@ -721,23 +721,35 @@ mod avx2_forces {
             let k = 4 * n_groups;
             let overlap = _mm256_sub_pd(r, d);
             let arm = _mm256_max_pd(d, zero);
-            store(&mut b.n, k, pl.n);
-            st(&mut b.overlap, k, overlap);
-            st(&mut b.arm, k, arm);
-            store(
-                &mut b.v_rel,
-                k,
-                sub(load_aos4(velocity.as_ptr().add(g)), pl.wall_v),
-            );
-            if rotation {
-                store(&mut b.spin, k, scale(arm, load_aos4(omega.as_ptr().add(g))));
-            }
+            let v_rel = sub(load_aos4(velocity.as_ptr().add(g)), pl.wall_v);
+            let spin = if rotation {
+                scale(arm, load_aos4(omega.as_ptr().add(g)))
+            } else {
+                v_rel
+            };
             let sp = |l: usize| &slots[s0 + l * stride];
             let mut src = [std::ptr::null(); 4];
             for (l, r) in src.iter_mut().enumerate() {
                 *r = &sp(l).history.x as *const f64;
             }
-            store(&mut b.history, k, load_rows3(src));
+            let history = load_rows3(src);
+            if m == 0b1111 && uniform && !c.shared.detail && (0..4).all(|l| sp(l).active) {
+                // four contacts that go on, the common case: forces and scatter (that of
+                // `plane_scatter`) from the lanes, without the batch; every lane of the
+                // batch holds the constants
+                let f = forces4::<E, true>(b, &c.shared, 0, pl.n, v_rel, spin, overlap, history);
+                plane_out_rows(out, g, q, stride, f.force, scale(arm, f.torque_per_arm));
+                plane_spring_rows(slots, g, q, stride, f.history);
+                continue;
+            }
+            store(&mut b.n, k, pl.n);
+            st(&mut b.overlap, k, overlap);
+            st(&mut b.arm, k, arm);
+            store(&mut b.v_rel, k, v_rel);
+            if rotation {
+                store(&mut b.spin, k, spin);
+            }
+            store(&mut b.history, k, history);
             if !uniform {
                 plane_constants(c, sp, k, b, all);
             }
@@ -754,6 +766,42 @@ mod avx2_forces {
             plane_scatter::<E>(c, first, &groups[..n_groups], slots, out, detail, b);
         }
         b.len = 0;
+    }
+
+    /// The outputs of the plane group of particles `g..g + 4`, slot column `q`, as rows:
+    /// force `f` and torque `t`, 6 f64 each.
+    #[inline(always)]
+    unsafe fn plane_out_rows(out: &mut [WallOut], g: usize, q: usize, stride: usize, f: V4, t: V4) {
+        let (fxy, fz_tx) = (lane_pairs(f.x, f.y), lane_pairs(f.z, t.x));
+        let tyz = lane_pairs(t.y, t.z);
+        let n = out.len();
+        for l in 0..4 {
+            let row = (g + l) * stride + q;
+            debug_assert!(row < n);
+            let dst = out.as_mut_ptr().add(row) as *mut f64;
+            _mm_storeu_pd(dst, lane_pair(fxy, l));
+            _mm_storeu_pd(dst.add(2), lane_pair(fz_tx, l));
+            _mm_storeu_pd(dst.add(4), lane_pair(tyz, l));
+        }
+    }
+
+    /// The springs of a plane group of four contacts that go on (see [`plane_out_rows`]),
+    /// as rows, and their onsets cleared.
+    #[inline(always)]
+    unsafe fn plane_spring_rows(
+        slots: &mut [WallContact],
+        g: usize,
+        q: usize,
+        stride: usize,
+        history: V4,
+    ) {
+        let mut dst = [std::ptr::null_mut(); 4];
+        for (l, d) in dst.iter_mut().enumerate() {
+            let s = &mut slots[(g + l) * stride + q];
+            s.onset = false;
+            *d = &mut s.history.x as *mut f64;
+        }
+        store_rows3(history, dst);
     }
 
     /// The constants of one group of [`plane_slots`] (slot of lane l: `sp(l)`) into lanes
@@ -804,30 +852,14 @@ mod avx2_forces {
         for (gi, &(g, q, m)) in groups.iter().enumerate() {
             let full = m == 0b1111;
             if full {
-                // the four outputs as rows: force and torque, 6 f64 each
                 let k = 4 * gi;
-                let f = load(&b.force, k);
                 let t = scale(ld(&b.arm, k), load(&b.torque_per_arm, k));
-                let (fxy, fz_tx) = (lane_pairs(f.x, f.y), lane_pairs(f.z, t.x));
-                let tyz = lane_pairs(t.y, t.z);
-                for l in 0..4 {
-                    let dst =
-                        out.as_mut_ptr().add((g as usize + l) * stride + q as usize) as *mut f64;
-                    _mm_storeu_pd(dst, lane_pair(fxy, l));
-                    _mm_storeu_pd(dst.add(2), lane_pair(fz_tx, l));
-                    _mm_storeu_pd(dst.add(4), lane_pair(tyz, l));
-                }
-                // four contacts that go on (the common case): `scatter_wall_lane` has only
-                // the spring and the cleared onset to write, as rows
-                let row = |l: usize| (g as usize + l) * stride + q as usize;
-                if !c.shared.detail && (0..4).all(|l| slots[row(l)].active) {
-                    let mut dst = [std::ptr::null_mut(); 4];
-                    for (l, d) in dst.iter_mut().enumerate() {
-                        let s = &mut slots[row(l)];
-                        s.onset = false;
-                        *d = &mut s.history.x as *mut f64;
-                    }
-                    store_rows3(load(&b.history, 4 * gi), dst);
+                let (g, q) = (g as usize, q as usize);
+                plane_out_rows(out, g, q, stride, load(&b.force, k), t);
+                // four contacts that go on: `scatter_wall_lane` has only the spring and the
+                // cleared onset to write, as rows
+                if !c.shared.detail && (0..4).all(|l| slots[(g + l) * stride + q].active) {
+                    plane_spring_rows(slots, g, q, stride, load(&b.history, k));
                     continue;
                 }
             }
@@ -870,9 +902,24 @@ mod avx2_forces {
         chunk: &mut [PairContact],
         out: &mut [PairOut],
     ) {
-        let f = load(&b.force, k);
-        let t = load(&b.torque_per_arm, k);
-        let overlap = ld(&b.overlap, k);
+        let (force, torque_per_arm) = (load(&b.force, k), load(&b.torque_per_arm, k));
+        let (overlap, history) = (ld(&b.overlap, k), load(&b.history, k));
+        rows4(b, k, force, torque_per_arm, overlap, history, chunk, out);
+    }
+
+    /// [`pair_rows`] from values in registers.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    unsafe fn rows4(
+        b: &Batch,
+        k: usize,
+        f: V4,
+        t: V4,
+        overlap: __m256d,
+        history: V4,
+        chunk: &mut [PairContact],
+        out: &mut [PairOut],
+    ) {
         let (fxy, fz_tx) = (lane_pairs(f.x, f.y), lane_pairs(f.z, t.x));
         let (tyz, ov) = (lane_pairs(t.y, t.z), lane_pairs(overlap, overlap));
         // (a loop, not `array::map`: a closure passed on loses the AVX2 build)
@@ -889,35 +936,219 @@ mod avx2_forces {
             _mm_store_sd(o.add(6), lane_pair(ov, l));
             *d = &mut p.history.x as *mut f64;
         }
-        store_rows3(load(&b.history, k), dst);
+        store_rows3(history, dst);
+    }
+
+    /// The pairs of a batch of uniform pairs ([`pair_chunk_batched`] with `U`) in one pass
+    /// over the lanes: geometry, forces and, for four pairs that go on in contact on a step
+    /// without records, the scatter as rows ([`rows4`]), with no round trip through the
+    /// batch. The other groups' results go to the batch for the lane-by-lane scatter;
+    /// returns a bit per such group (group g: lanes 4g..4g + 4).
+    #[target_feature(enable = "avx2")]
+    pub(super) unsafe fn uniform_pairs<const E: u16>(
+        b: &mut Batch,
+        c: &PairCtx<'_>,
+        chunk: &mut [PairContact],
+        active: &[bool],
+        out: &mut [PairOut],
+    ) -> u16 {
+        let rotation = on::<E>(c.effects, Effect::Rotation);
+        let len = b.len.min(BATCH);
+        let mut rest = 0u16;
+        let mut k = 0;
+        while k < len {
+            let (n, overlap, spin) = geometry4::<E>(b, c, k);
+            let (v_rel, history) = (load(&b.v_rel, k), load(&b.history, k));
+            let f = forces4::<E, true>(b, c, k, n, v_rel, spin, overlap, history);
+            let going_on = |l: usize| active.get(b.index[k + l] as usize) == Some(&true);
+            if !c.detail && k + 4 <= len && going_on(0) && going_on(1) && going_on(2) && going_on(3)
+            {
+                rows4(
+                    b,
+                    k,
+                    f.force,
+                    f.torque_per_arm,
+                    overlap,
+                    f.history,
+                    chunk,
+                    out,
+                );
+            } else {
+                store(&mut b.n, k, n);
+                st(&mut b.overlap, k, overlap);
+                if rotation {
+                    store(&mut b.spin, k, spin);
+                }
+                store_forces::<E>(b, c, k, &f);
+                rest |= 1 << (k / 4);
+            }
+            k += 4;
+        }
+        rest
+    }
+
+    /// Overlap, unit normal and spin of the pairs in lanes `k..k + 4` (`pair_geometry`'s
+    /// operations).
+    #[inline(always)]
+    unsafe fn geometry4<const E: u16>(b: &Batch, c: &PairCtx<'_>, k: usize) -> (V4, __m256d, V4) {
+        let rotation = on::<E>(c.effects, Effect::Rotation);
+        let d = load(&b.n, k);
+        let dist = _mm256_sqrt_pd(ld(&b.overlap, k));
+        // f64::max(x, MIN_POSITIVE): maxpd returns its second operand for NaN, as max does
+        let overlap = _mm256_max_pd(
+            _mm256_sub_pd(ld(&b.r_sum, k), dist),
+            _mm256_set1_pd(f64::MIN_POSITIVE),
+        );
+        let n = scale(_mm256_div_pd(_mm256_set1_pd(1.0), dist), d);
+        let mut spin = n;
+        if rotation {
+            let h = _mm256_mul_pd(_mm256_set1_pd(0.5), overlap);
+            let arm_i = _mm256_sub_pd(ld(&b.r_i, k), h);
+            let arm_j = _mm256_sub_pd(ld(&b.r_j, k), h);
+            spin = add(
+                scale(arm_i, load(&b.omega_i, k)),
+                scale(arm_j, load(&b.omega_j, k)),
+            );
+        }
+        (n, overlap, spin)
     }
 
     #[target_feature(enable = "avx2")]
     pub(super) unsafe fn pair_geometry<const E: u16>(b: &mut Batch, c: &PairCtx<'_>) {
         let rotation = on::<E>(c.effects, Effect::Rotation);
-        let one = _mm256_set1_pd(1.0);
-        let half = _mm256_set1_pd(0.5);
-        let min_positive = _mm256_set1_pd(f64::MIN_POSITIVE);
         let len = b.len.min(BATCH);
         let mut k = 0;
         while k < len {
-            let d = load(&b.n, k);
-            let dist = _mm256_sqrt_pd(ld(&b.overlap, k));
-            // f64::max(x, MIN_POSITIVE): maxpd returns its second operand for NaN, as max does
-            let overlap = _mm256_max_pd(_mm256_sub_pd(ld(&b.r_sum, k), dist), min_positive);
-            store(&mut b.n, k, scale(_mm256_div_pd(one, dist), d));
+            let (n, overlap, spin) = geometry4::<E>(b, c, k);
+            store(&mut b.n, k, n);
             st(&mut b.overlap, k, overlap);
             if rotation {
-                let h = _mm256_mul_pd(half, overlap);
-                let arm_i = _mm256_sub_pd(ld(&b.r_i, k), h);
-                let arm_j = _mm256_sub_pd(ld(&b.r_j, k), h);
-                let spin = add(
-                    scale(arm_i, load(&b.omega_i, k)),
-                    scale(arm_j, load(&b.omega_j, k)),
-                );
                 store(&mut b.spin, k, spin);
             }
             k += 4;
+        }
+    }
+
+    /// What [`forces4`] gives for four contacts: force on the particle (pair: i), N;
+    /// n × f_t, N; the new spring ξ, m; the normal force, N.
+    #[derive(Clone, Copy)]
+    struct Forces4 {
+        force: V4,
+        torque_per_arm: V4,
+        history: V4,
+        f_n: __m256d,
+    }
+
+    /// The force pass on four contacts: `n`, `v_rel`, `spin` (with rotation), `overlap`
+    /// and the spring `history` as lanes, the law constants from lanes `k..k + 4` of the
+    /// batch.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    unsafe fn forces4<const E: u16, const H: bool>(
+        b: &Batch,
+        c: &PairCtx<'_>,
+        k: usize,
+        n: V4,
+        mut v_rel: V4,
+        spin: V4,
+        overlap: __m256d,
+        history: V4,
+    ) -> Forces4 {
+        let rotation = on::<E>(c.effects, Effect::Rotation);
+        let friction = on::<E>(c.effects, Effect::Friction);
+        let damping = on::<E>(c.effects, Effect::Damping);
+        let zero = _mm256_setzero_pd();
+        let sign = _mm256_set1_pd(-0.0);
+        if rotation {
+            v_rel = add(v_rel, cross(spin, n));
+        }
+        let v_n = dot(v_rel, n);
+        let v_t = sub(v_rel, scale(v_n, n));
+        // the Hertz law where the lanes hold its constants (`law_at`'s operations; with
+        // `H`, every lane does)
+        let sq = _mm256_sqrt_pd(overlap);
+        let (f_el, c_n, k_t) = (ld(&b.f_el, k), ld(&b.c_n, k), ld(&b.k_t, k));
+        let hertz_f_el = _mm256_mul_pd(_mm256_mul_pd(f_el, sq), overlap);
+        let hertz_c_n = if damping {
+            _mm256_mul_pd(c_n, _mm256_sqrt_pd(sq))
+        } else {
+            zero
+        };
+        let hertz_k_t = _mm256_mul_pd(k_t, sq);
+        let (f_el, c_n, k_t) = if H {
+            (hertz_f_el, hertz_c_n, hertz_k_t)
+        } else {
+            let hertz =
+                _mm256_castsi256_pd(_mm256_loadu_si256(b.hertz.as_ptr().add(k) as *const __m256i));
+            (
+                _mm256_blendv_pd(f_el, hertz_f_el, hertz),
+                _mm256_blendv_pd(c_n, hertz_c_n, hertz),
+                _mm256_blendv_pd(k_t, hertz_k_t, hertz),
+            )
+        };
+        let mut f_n = _mm256_add_pd(f_el, _mm256_mul_pd(c_n, v_n));
+        if c.clamp {
+            // f_n < 0 → 0 (NaN stays)
+            let neg = _mm256_cmp_pd::<_CMP_LT_OQ>(f_n, zero);
+            f_n = _mm256_blendv_pd(f_n, zero, neg);
+        }
+        let mut force = scale(_mm256_xor_pd(f_n, sign), n);
+        let mut torque_per_arm = V4 {
+            x: zero,
+            y: zero,
+            z: zero,
+        };
+        let mut history = history;
+        if friction {
+            let c_t = _mm256_mul_pd(c_n, ld(&b.ct_ratio, k));
+            // f64::max(f_n, 0): 0 for NaN, as maxpd returns its second operand then
+            let cap = _mm256_mul_pd(ld(&b.mu, k), _mm256_max_pd(f_n, zero));
+            let mut xi = history;
+            xi = sub(xi, scale(dot(xi, n), n));
+            xi = add(xi, scale(_mm256_set1_pd(c.dt), v_t));
+            let f_stick = sub(scale(_mm256_xor_pd(k_t, sign), xi), scale(c_t, v_t));
+            let f2 = dot(f_stick, f_stick);
+            let sliding = _mm256_cmp_pd::<_CMP_GT_OQ>(f2, _mm256_mul_pd(cap, cap));
+            let f_t = if _mm256_movemask_pd(sliding) == 0 {
+                // no lane slides (the usual case between particles of a pack): the cone's
+                // square root and two divisions are not needed
+                history = xi;
+                f_stick
+            } else {
+                let f_slide = scale(_mm256_div_pd(cap, _mm256_sqrt_pd(f2)), f_stick);
+                let inv = _mm256_div_pd(_mm256_set1_pd(-1.0), k_t);
+                let stiff = _mm256_cmp_pd::<_CMP_GT_OQ>(k_t, zero);
+                let xi_slide = V4 {
+                    x: _mm256_and_pd(_mm256_mul_pd(f_slide.x, inv), stiff),
+                    y: _mm256_and_pd(_mm256_mul_pd(f_slide.y, inv), stiff),
+                    z: _mm256_and_pd(_mm256_mul_pd(f_slide.z, inv), stiff),
+                };
+                history = select(sliding, xi_slide, xi);
+                select(sliding, f_slide, f_stick)
+            };
+            force = add(force, f_t);
+            if rotation {
+                torque_per_arm = cross(n, f_t);
+            }
+        }
+        Forces4 {
+            force,
+            torque_per_arm,
+            history,
+            f_n,
+        }
+    }
+
+    /// The batch's results of [`forces4`] at lanes `k..k + 4`.
+    #[inline(always)]
+    unsafe fn store_forces<const E: u16>(b: &mut Batch, c: &PairCtx<'_>, k: usize, f: &Forces4) {
+        store(&mut b.force, k, f.force);
+        store(&mut b.torque_per_arm, k, f.torque_per_arm);
+        if on::<E>(c.effects, Effect::Friction) {
+            store(&mut b.history, k, f.history);
+        }
+        if c.detail {
+            st(&mut b.f_n, k, f.f_n);
         }
     }
 
@@ -927,95 +1158,25 @@ mod avx2_forces {
         c: &PairCtx<'_>,
     ) {
         let rotation = on::<E>(c.effects, Effect::Rotation);
-        let friction = on::<E>(c.effects, Effect::Friction);
-        let damping = on::<E>(c.effects, Effect::Damping);
-        let zero = _mm256_setzero_pd();
-        let sign = _mm256_set1_pd(-0.0);
-        let dt = _mm256_set1_pd(c.dt);
-        let minus_one = _mm256_set1_pd(-1.0);
         let len = b.len.min(BATCH);
         let mut k = 0;
         while k < len {
-            let n = load(&b.n, k);
-            let mut v_rel = load(&b.v_rel, k);
-            if rotation {
-                v_rel = add(v_rel, cross(load(&b.spin, k), n));
-            }
-            let v_n = dot(v_rel, n);
-            let v_t = sub(v_rel, scale(v_n, n));
-            // the Hertz law where the lanes hold its constants (`law_at`'s operations; with
-            // `H`, every lane does)
-            let overlap = ld(&b.overlap, k);
-            let sq = _mm256_sqrt_pd(overlap);
-            let (f_el, c_n, k_t) = (ld(&b.f_el, k), ld(&b.c_n, k), ld(&b.k_t, k));
-            let hertz_f_el = _mm256_mul_pd(_mm256_mul_pd(f_el, sq), overlap);
-            let hertz_c_n = if damping {
-                _mm256_mul_pd(c_n, _mm256_sqrt_pd(sq))
+            let spin = if rotation {
+                load(&b.spin, k)
             } else {
-                zero
+                load(&b.n, k)
             };
-            let hertz_k_t = _mm256_mul_pd(k_t, sq);
-            let (f_el, c_n, k_t) = if H {
-                (hertz_f_el, hertz_c_n, hertz_k_t)
-            } else {
-                let hertz = _mm256_castsi256_pd(_mm256_loadu_si256(
-                    b.hertz.as_ptr().add(k) as *const __m256i
-                ));
-                (
-                    _mm256_blendv_pd(f_el, hertz_f_el, hertz),
-                    _mm256_blendv_pd(c_n, hertz_c_n, hertz),
-                    _mm256_blendv_pd(k_t, hertz_k_t, hertz),
-                )
-            };
-            let mut f_n = _mm256_add_pd(f_el, _mm256_mul_pd(c_n, v_n));
-            if c.clamp {
-                // f_n < 0 → 0 (NaN stays)
-                let neg = _mm256_cmp_pd::<_CMP_LT_OQ>(f_n, zero);
-                f_n = _mm256_blendv_pd(f_n, zero, neg);
-            }
-            let mut force = scale(_mm256_xor_pd(f_n, sign), n);
-            let mut torque_per_arm = V4 {
-                x: zero,
-                y: zero,
-                z: zero,
-            };
-            if friction {
-                let c_t = _mm256_mul_pd(c_n, ld(&b.ct_ratio, k));
-                // f64::max(f_n, 0): 0 for NaN, as maxpd returns its second operand then
-                let cap = _mm256_mul_pd(ld(&b.mu, k), _mm256_max_pd(f_n, zero));
-                let mut xi = load(&b.history, k);
-                xi = sub(xi, scale(dot(xi, n), n));
-                xi = add(xi, scale(dt, v_t));
-                let f_stick = sub(scale(_mm256_xor_pd(k_t, sign), xi), scale(c_t, v_t));
-                let f2 = dot(f_stick, f_stick);
-                let sliding = _mm256_cmp_pd::<_CMP_GT_OQ>(f2, _mm256_mul_pd(cap, cap));
-                let f_t = if _mm256_movemask_pd(sliding) == 0 {
-                    // no lane slides (the usual case between particles of a pack): the
-                    // cone's square root and two divisions are not needed
-                    store(&mut b.history, k, xi);
-                    f_stick
-                } else {
-                    let f_slide = scale(_mm256_div_pd(cap, _mm256_sqrt_pd(f2)), f_stick);
-                    let inv = _mm256_div_pd(minus_one, k_t);
-                    let stiff = _mm256_cmp_pd::<_CMP_GT_OQ>(k_t, zero);
-                    let xi_slide = V4 {
-                        x: _mm256_and_pd(_mm256_mul_pd(f_slide.x, inv), stiff),
-                        y: _mm256_and_pd(_mm256_mul_pd(f_slide.y, inv), stiff),
-                        z: _mm256_and_pd(_mm256_mul_pd(f_slide.z, inv), stiff),
-                    };
-                    store(&mut b.history, k, select(sliding, xi_slide, xi));
-                    select(sliding, f_slide, f_stick)
-                };
-                force = add(force, f_t);
-                if rotation {
-                    torque_per_arm = cross(n, f_t);
-                }
-            }
-            store(&mut b.force, k, force);
-            store(&mut b.torque_per_arm, k, torque_per_arm);
-            if c.detail {
-                st(&mut b.f_n, k, f_n);
-            }
+            let f = forces4::<E, H>(
+                b,
+                c,
+                k,
+                load(&b.n, k),
+                load(&b.v_rel, k),
+                spin,
+                ld(&b.overlap, k),
+                load(&b.history, k),
+            );
+            store_forces::<E>(b, c, k, &f);
             k += 4;
         }
     }
@@ -1123,17 +1284,35 @@ pub(super) fn pair_chunk_batched<const E: u16, const U: bool>(
             }
         }
         b.len = m;
-        // ---- overlaps and normals, laws, forces
-        pair_geometry::<E>(b, c);
-        if pending {
-            b.set_laws::<E>(c, |e| c.table[konst[e] as usize]);
+        // ---- overlaps and normals, laws, forces (uniform pairs: and the scatter of the
+        // groups that go on, leaving the others to the loop below)
+        let mut rest = u16::MAX;
+        #[cfg(target_arch = "x86_64")]
+        if U {
+            // SAFETY: `U` is set only with `avx2`, which is set only when the CPU reported
+            // AVX2.
+            rest = unsafe { avx2_forces::uniform_pairs::<E>(b, c, chunk, active, out) };
         }
-        contact_forces::<E>(b, c, hertz);
+        if !U {
+            pair_geometry::<E>(b, c);
+            if pending {
+                b.set_laws::<E>(c, |e| c.table[konst[e] as usize]);
+            }
+            contact_forces::<E>(b, c, hertz);
+        }
         // ---- scatter
         let mut k = 0;
         while k < b.len {
+            if rest >> (k / 4) & 1 == 0 {
+                // scattered as rows by `uniform_pairs`
+                k += 4;
+                continue;
+            }
+            // (with `U`, `uniform_pairs` took every such group; a window here would start
+            // inside a group it left)
             #[cfg(target_arch = "x86_64")]
-            if c.avx2
+            if !U
+                && c.avx2
                 && !c.detail
                 && k + 4 <= b.len
                 && (0..4).all(|l| active.get(b.index[k + l] as usize) == Some(&true))
