@@ -78,8 +78,10 @@ fn main() {
     let (pairs, slots) = sim.candidate_counts();
     let walls: u32 = sim.wall_contact_counts().iter().sum();
     eprintln!(
-        "candidate pairs {pairs} (sleeping {}) wall slots {slots} active wall contacts {walls}",
-        sim.sleeping_pairs()
+        "candidate pairs {pairs} (sleeping {}) wall slots {slots} (plane pass {}) active wall \
+         contacts {walls}",
+        sim.sleeping_pairs(),
+        sim.plane_pass_slots()
     );
     println!(
         "state hash {hash:016x} steps {} rebuilds {} Z {:.3} max overlap {:.3e} x0 {:?}",

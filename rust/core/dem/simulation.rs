@@ -1176,7 +1176,6 @@ fn wall_chunk<const E: u16>(
     }
 }
 
-/// What the particle phase reads to sum the forces on a particle (see [`Gather::particle`]).
 /// A running sum of vectors (glam's `+=`, component by component). On x86_64 it keeps x
 /// and y in one SSE2 register and z apart: left to itself, LLVM packs the gather's force and
 /// torque sums into 256-bit shapes that need a lane-crossing `vpermpd` per contact (3 µops
@@ -1251,6 +1250,7 @@ impl Sum3 {
     }
 }
 
+/// What the particle phase reads to sum the forces on a particle (see [`Gather::particle`]).
 struct Gather<'a> {
     c: &'a ParticleCtx<'a>,
     /// The chunk's slices (index k = particle − first).
