@@ -733,11 +733,16 @@ mod avx2_forces {
                 *r = &sp(l).history.x as *const f64;
             }
             let history = load_rows3(src);
-            if m == 0b1111 && uniform && !c.shared.detail && (0..4).all(|l| sp(l).active) {
+            // the group's constants in lanes k..k + 4 (every lane holds them already when
+            // all groups share one entry)
+            if !uniform {
+                plane_constants(c, sp, k, b, all);
+            }
+            if m == 0b1111 && !c.shared.detail && (0..4).all(|l| sp(l).active) {
                 // four contacts that go on, the common case: forces and scatter (that of
-                // `plane_scatter`) from the lanes, without the batch; every lane of the
-                // batch holds the constants
-                let f = forces4::<E, true>(b, &c.shared, 0, pl.n, v_rel, spin, overlap, history);
+                // `plane_scatter`) from the lanes, without the batch; the lanes k..k + 4
+                // are not claimed, so the next group reuses them
+                let f = forces4::<E, true>(b, &c.shared, k, pl.n, v_rel, spin, overlap, history);
                 plane_out_rows(out, g, q, stride, f.force, scale(arm, f.torque_per_arm));
                 plane_spring_rows(slots, g, q, stride, f.history);
                 continue;
@@ -750,9 +755,6 @@ mod avx2_forces {
                 store(&mut b.spin, k, spin);
             }
             store(&mut b.history, k, history);
-            if !uniform {
-                plane_constants(c, sp, k, b, all);
-            }
             groups[n_groups] = (g as u32, q as u32, m);
             n_groups += 1;
             b.len = 4 * n_groups;
@@ -774,11 +776,8 @@ mod avx2_forces {
     unsafe fn plane_out_rows(out: &mut [WallOut], g: usize, q: usize, stride: usize, f: V4, t: V4) {
         let (fxy, fz_tx) = (lane_pairs(f.x, f.y), lane_pairs(f.z, t.x));
         let tyz = lane_pairs(t.y, t.z);
-        let n = out.len();
         for l in 0..4 {
-            let row = (g + l) * stride + q;
-            debug_assert!(row < n);
-            let dst = out.as_mut_ptr().add(row) as *mut f64;
+            let dst = &mut out[(g + l) * stride + q] as *mut WallOut as *mut f64;
             _mm_storeu_pd(dst, lane_pair(fxy, l));
             _mm_storeu_pd(dst.add(2), lane_pair(fz_tx, l));
             _mm_storeu_pd(dst.add(4), lane_pair(tyz, l));
@@ -850,18 +849,13 @@ mod avx2_forces {
         let stride = c.wall_stride;
         let moving = on::<E>(c.shared.effects, Effect::MovingWalls);
         for (gi, &(g, q, m)) in groups.iter().enumerate() {
+            // (four contacts that go on, on a step without records, never get here:
+            // `plane_slots` scatters them from the lanes)
             let full = m == 0b1111;
             if full {
                 let k = 4 * gi;
                 let t = scale(ld(&b.arm, k), load(&b.torque_per_arm, k));
-                let (g, q) = (g as usize, q as usize);
-                plane_out_rows(out, g, q, stride, load(&b.force, k), t);
-                // four contacts that go on: `scatter_wall_lane` has only the spring and the
-                // cleared onset to write, as rows
-                if !c.shared.detail && (0..4).all(|l| slots[(g + l) * stride + q].active) {
-                    plane_spring_rows(slots, g, q, stride, load(&b.history, k));
-                    continue;
-                }
+                plane_out_rows(out, g as usize, q as usize, stride, load(&b.force, k), t);
             }
             for l in 0..4 {
                 if m >> l & 1 == 0 {
