@@ -7,6 +7,9 @@
 //! An optional fourth argument runs an effect variant of the bench (`without_damping`,
 //! `without_belt`, `plus_planar`, `plus_rolling_resistance`) from the settled state instead.
 //!
+//! With `DEMFEM_PHASE_TIMES` set, it prints each thread's time in the force and the particle
+//! phase (`Simulation::phase_times`).
+//!
 //! Usage: `dem_instr <checkpoint path> <steps> [threads] [variant]`.
 use demfem::dem::table::{anchor_scene, TableStart};
 use demfem::dem::{Effect, Simulation};
@@ -60,7 +63,17 @@ fn main() {
         }
         sim = Simulation::new(&scene).unwrap();
     }
+    // DEMFEM_PHASE_TIMES=1: print each thread's time in the force and particle phases
+    let timed = std::env::var_os("DEMFEM_PHASE_TIMES").is_some();
+    sim.set_phase_timing(timed);
+    let clock = std::time::Instant::now();
     sim.step(steps).unwrap();
+    if timed {
+        eprintln!("steps: {:.3} s", clock.elapsed().as_secs_f64());
+    }
+    for (t, [force, particle]) in sim.phase_times().iter().enumerate() {
+        eprintln!("thread {t}: force phase {force:.3} s, particle phase {particle:.3} s");
+    }
     let z: u32 = sim.coordination().iter().sum();
     // FNV-1a over the bits of every position, velocity and angular velocity: equal hashes
     // mean bitwise equal states

@@ -58,6 +58,7 @@ use crate::dem::record::{ContactOnset, ContactRecord, Frame, Partner};
 use crate::dem::scene::Scene;
 use crate::error::{DemfemError, Result};
 use crate::geometry::{Vec3, Wall, WallShape};
+use std::sync::atomic::{AtomicU64, Ordering};
 
 mod batch;
 use batch::{pair_chunk_batched, wall_chunk_batched, Batch, BATCH, BATCH_SCRATCH};
@@ -399,6 +400,9 @@ pub struct Simulation {
     /// Per block of the particle phase: (largest squared displacement since the last rebuild,
     /// m², largest squared speed, m²/s², any non-finite value, wall onsets).
     chunk_results: Vec<(f64, f64, bool, u32)>,
+    /// Per block: nanoseconds spent in the force phase and in the particle phase, summed
+    /// over steps; empty unless [`Simulation::set_phase_timing`] turned the clock on.
+    phase_clock: Vec<[AtomicU64; 2]>,
     pub(crate) contact_force_sum: Vec<Vec3>,
     pub(crate) coordination: Vec<u32>,
     pub(crate) wall_coordination: Vec<u32>,
@@ -599,6 +603,19 @@ fn join_parts<T: Send, F: Fn(T) + Sync>(mut parts: std::vec::IntoIter<T>, run: &
         } else {
             rayon::join(|| run(first), || join_parts(parts, run));
         }
+    }
+}
+
+/// Adds the time since `start` (if the clock runs) to block `block`'s phase `phase`.
+fn clock_add(
+    clock: &[[AtomicU64; 2]],
+    block: usize,
+    phase: usize,
+    start: Option<std::time::Instant>,
+) {
+    if let (Some(start), Some(c)) = (start, clock.get(block)) {
+        let ns = u64::try_from(start.elapsed().as_nanos()).unwrap_or(u64::MAX);
+        c[phase].fetch_add(ns, Ordering::Relaxed);
     }
 }
 
@@ -1632,6 +1649,7 @@ impl Simulation {
             wall_state: vec![WallState::default(); scene.walls.len()],
             chunk_flips: Vec::new(),
             chunk_results: Vec::new(),
+            phase_clock: Vec::new(),
             contact_force_sum: vec![Vec3::ZERO; n],
             coordination: vec![0; n],
             wall_coordination: vec![0; n],
@@ -2186,7 +2204,9 @@ impl Simulation {
             let wall_lists = &self.wall_lists;
             flips.clear();
             flips.resize(pairs.len().div_ceil(PAIR_CHUNK), Flips::default());
+            let clock = &self.phase_clock;
             let run = |(t, part): (usize, ForcePart<'_>)| {
+                let start = (!clock.is_empty()).then(std::time::Instant::now);
                 let (first_particle, first_pair) = if t == 0 { (0, 0) } else { cut[t - 1] };
                 let konst = &pair_const[first_pair..first_pair + part.pairs.len()];
                 let chunks = part
@@ -2217,6 +2237,7 @@ impl Simulation {
                     let (s, o, d) = (part.slots, part.wall_out, part.wall_detail);
                     simd::wall::<E>(avx2, &wall_ctx, first_particle, block, s, o, d, b)
                 });
+                clock_add(clock, t, 0, start);
             };
             if parallel {
                 // one part per thread: the pairs whose first particle is in a block of
@@ -2325,15 +2346,19 @@ impl Simulation {
                     ),
                     &'c mut [(f64, f64, bool, u32)],
                 );
+                let clock = &self.phase_clock;
                 let run = |(t, ((((((x, v), w), f), z), zw), res)): (usize, Part<'_>)| {
+                    let start = (!clock.is_empty()).then(std::time::Instant::now);
                     let first = if t == 0 { 0 } else { cuts[t - 1] };
                     let len = x.len();
                     let slots = &slots[first * stride..(first + len) * stride];
                     let outs = &outs[first * stride..(first + len) * stride];
                     res[0] = simd::particle::<E>(avx2, &ctx, first, x, v, w, f, z, zw, slots, outs);
+                    clock_add(clock, t, 1, start);
                 };
                 join_parts(parts.into_iter(), &run);
             } else {
+                let start = (!self.phase_clock.is_empty()).then(std::time::Instant::now);
                 let result = simd::particle::<E>(
                     avx2,
                     &ctx,
@@ -2347,6 +2372,7 @@ impl Simulation {
                     &self.wall_slots,
                     &self.wall_out,
                 );
+                clock_add(&self.phase_clock, 0, 1, start);
                 self.chunk_results.clear();
                 self.chunk_results.push(result);
             }
@@ -2544,6 +2570,27 @@ impl Simulation {
     /// rolling resistance always run one at a time.
     pub fn set_batched(&mut self, on: bool) {
         self.batched = on;
+    }
+
+    /// Start (`true`, from zero) or stop the clock of [`Simulation::phase_times`]. Off by
+    /// default: it reads the clock twice per block and phase in every step.
+    pub fn set_phase_timing(&mut self, on: bool) {
+        self.phase_clock.clear();
+        if on {
+            let blocks = self.threads.max(1);
+            self.phase_clock
+                .extend((0..blocks).map(|_| [AtomicU64::new(0), AtomicU64::new(0)]));
+        }
+    }
+
+    /// Per block of the step (one per thread): seconds spent in the force phase and in the
+    /// particle phase since [`Simulation::set_phase_timing`] turned the clock on (empty if
+    /// it is off). A development aid for the balance between threads.
+    pub fn phase_times(&self) -> Vec<[f64; 2]> {
+        self.phase_clock
+            .iter()
+            .map(|c| c.each_ref().map(|a| a.load(Ordering::Relaxed) as f64 * 1e-9))
+            .collect()
     }
 
     /// How many particle–wall slots the AVX2 plane pass took in the last step (four particles
