@@ -385,6 +385,8 @@ pub struct Simulation {
     /// `PARTICLE_CHUNK`, pair boundaries (the first pair whose i is in the next block,
     /// rounded) at multiples of `PAIR_CHUNK`.
     part_cuts: Vec<(usize, usize)>,
+    /// `part_cuts` as the parallel step cuts its arrays (see [`CutLists`]).
+    cut_lists: CutLists,
     /// The wall slots of the batched kernels, listed once per neighbour list (see
     /// [`Simulation::list_wall_slots`]).
     wall_lists: WallLists,
@@ -549,6 +551,24 @@ struct PairLists<'a> {
     rolling: &'a mut [Vec3],
 }
 
+/// The positions at which the parallel step cuts each kind of array into the threads'
+/// blocks, derived from `Simulation::part_cuts` and the wall stride when those change rather
+/// than collected in every step (seven allocations per step on two threads).
+#[derive(Debug, Default)]
+struct CutLists {
+    /// Particle arrays.
+    particle: Vec<usize>,
+    /// Pair arrays.
+    pair: Vec<usize>,
+    /// The pair chunks' onset counts (a pair cut is a multiple of `PAIR_CHUNK` or the end of
+    /// the list).
+    chunk: Vec<usize>,
+    /// Wall slot arrays.
+    slot: Vec<usize>,
+    /// One result per block: 1, 2, ….
+    block: Vec<usize>,
+}
+
 /// One thread's block of the parallel force phase (see `Simulation::part_cuts`).
 struct ForcePart<'a> {
     pairs: &'a mut [PairContact],
@@ -596,9 +616,15 @@ struct BlockWalls<'a> {
 /// Runs `run` on every part, the first on the calling thread, the others offered to the
 /// pool's threads through nested `rayon::join`s (cheaper than a scope: no heap-allocated
 /// job, and a part no thread has taken yet is run by the caller rather than waited for).
-fn join_parts<T: Send, F: Fn(T) + Sync>(mut parts: std::vec::IntoIter<T>, run: &F) {
+/// The parts come straight from their iterator, not collected first.
+fn join_parts<T, I, F>(parts: &mut std::iter::Peekable<I>, run: &F)
+where
+    T: Send,
+    I: Iterator<Item = T> + Send,
+    F: Fn(T) + Sync,
+{
     if let Some(first) = parts.next() {
-        if parts.len() == 0 {
+        if parts.peek().is_none() {
             run(first);
         } else {
             rayon::join(|| run(first), || join_parts(parts, run));
@@ -1622,6 +1648,7 @@ impl Simulation {
             travel_slack: 0.0,
             travel_step: 0.0,
             part_cuts: Vec::new(),
+            cut_lists: CutLists::default(),
             wall_lists: WallLists::default(),
             pair_out: Vec::new(),
             pair_detail: Vec::new(),
@@ -1826,6 +1853,20 @@ impl Simulation {
     /// and wall slot, and the wall slots' output arrays. A pure function of the lists and the
     /// static data (run after a rebuild and a restore).
     pub(crate) fn refresh_contact_constants(&mut self) {
+        let stride = self.wall_stride;
+        let cuts = &mut self.cut_lists;
+        let part_cuts = &self.part_cuts;
+        cuts.particle.clear();
+        cuts.particle.extend(part_cuts.iter().map(|c| c.0));
+        cuts.pair.clear();
+        cuts.pair.extend(part_cuts.iter().map(|c| c.1));
+        cuts.chunk.clear();
+        cuts.chunk
+            .extend(part_cuts.iter().map(|c| c.1.div_ceil(PAIR_CHUNK)));
+        cuts.slot.clear();
+        cuts.slot.extend(part_cuts.iter().map(|c| c.0 * stride));
+        cuts.block.clear();
+        cuts.block.extend(1..=part_cuts.len());
         self.wall_lists.mode = None;
         let n_slots = self.wall_slots.len();
         self.wall_out.clear();
@@ -2243,12 +2284,13 @@ impl Simulation {
                 // one part per thread: the pairs whose first particle is in a block of
                 // particles, and that block's wall slots; the particle phase then advances the
                 // same block, mostly on the same core (the calling thread always runs part 0)
-                let pair_cuts: Vec<usize> = cut.iter().map(|c| c.1).collect();
-                // a cut is a multiple of PAIR_CHUNK or the end of the list
-                let chunk_cuts: Vec<usize> =
-                    pair_cuts.iter().map(|e| e.div_ceil(PAIR_CHUNK)).collect();
-                let slot_cuts: Vec<usize> = cut.iter().map(|c| c.0 * stride).collect();
-                let parts: Vec<_> = split_at_cuts(pairs, &pair_cuts)
+                let CutLists {
+                    pair: pair_cuts,
+                    chunk: chunk_cuts,
+                    slot: slot_cuts,
+                    ..
+                } = &self.cut_lists;
+                let mut parts = split_at_cuts(pairs, &pair_cuts)
                     .zip(split_at_cuts(pair_active, &pair_cuts))
                     .zip(split_at_cuts(pair_wake, &pair_cuts))
                     .zip(split_at_cuts(pair_out, &pair_cuts))
@@ -2275,8 +2317,8 @@ impl Simulation {
                         },
                     )
                     .enumerate()
-                    .collect();
-                join_parts(parts.into_iter(), &run);
+                    .peekable();
+                join_parts(&mut parts, &run);
             } else {
                 let whole = ForcePart {
                     pairs,
@@ -2318,12 +2360,15 @@ impl Simulation {
             };
             if parallel {
                 // the blocks of the force phase (see there); one result per block
-                let cuts: Vec<usize> = self.part_cuts.iter().map(|c| c.0).collect();
-                let n_parts = cuts.len() + 1;
-                let result_cuts: Vec<usize> = (1..n_parts).collect();
+                let CutLists {
+                    particle: cuts,
+                    block: result_cuts,
+                    ..
+                } = &self.cut_lists;
                 self.chunk_results.clear();
-                self.chunk_results.resize(n_parts, (0.0, 0.0, false, 0));
-                let parts: Vec<_> = split_at_cuts(&mut self.position, &cuts)
+                self.chunk_results
+                    .resize(cuts.len() + 1, (0.0, 0.0, false, 0));
+                let mut parts = split_at_cuts(&mut self.position, &cuts)
                     .zip(split_at_cuts(&mut self.velocity, &cuts))
                     .zip(split_at_cuts(&mut self.omega, &cuts))
                     .zip(split_at_cuts(&mut self.contact_force_sum, &cuts))
@@ -2331,7 +2376,7 @@ impl Simulation {
                     .zip(split_at_cuts(&mut self.wall_coordination, &cuts))
                     .zip(split_at_cuts(&mut self.chunk_results, &result_cuts))
                     .enumerate()
-                    .collect();
+                    .peekable();
                 let (slots, outs) = (&self.wall_slots, &self.wall_out);
                 type Part<'c> = (
                     (
@@ -2356,7 +2401,7 @@ impl Simulation {
                     res[0] = simd::particle::<E>(avx2, &ctx, first, x, v, w, f, z, zw, slots, outs);
                     clock_add(clock, t, 1, start);
                 };
-                join_parts(parts.into_iter(), &run);
+                join_parts(&mut parts, &run);
             } else {
                 let start = (!self.phase_clock.is_empty()).then(std::time::Instant::now);
                 let result = simd::particle::<E>(
@@ -2589,7 +2634,10 @@ impl Simulation {
     pub fn phase_times(&self) -> Vec<[f64; 2]> {
         self.phase_clock
             .iter()
-            .map(|c| c.each_ref().map(|a| a.load(Ordering::Relaxed) as f64 * 1e-9))
+            .map(|c| {
+                c.each_ref()
+                    .map(|a| a.load(Ordering::Relaxed) as f64 * 1e-9)
+            })
             .collect()
     }
 
