@@ -2290,16 +2290,16 @@ impl Simulation {
                     slot: slot_cuts,
                     ..
                 } = &self.cut_lists;
-                let mut parts = split_at_cuts(pairs, &pair_cuts)
-                    .zip(split_at_cuts(pair_active, &pair_cuts))
-                    .zip(split_at_cuts(pair_wake, &pair_cuts))
-                    .zip(split_at_cuts(pair_out, &pair_cuts))
-                    .zip(split_at_cuts(pair_detail, &pair_cuts))
-                    .zip(split_at_cuts(pair_rolling, &pair_cuts))
-                    .zip(split_at_cuts(flips, &chunk_cuts))
-                    .zip(split_at_cuts(slots, &slot_cuts))
-                    .zip(split_at_cuts(wall_out, &slot_cuts))
-                    .zip(split_at_cuts(wall_detail, &slot_cuts))
+                let mut parts = split_at_cuts(pairs, pair_cuts)
+                    .zip(split_at_cuts(pair_active, pair_cuts))
+                    .zip(split_at_cuts(pair_wake, pair_cuts))
+                    .zip(split_at_cuts(pair_out, pair_cuts))
+                    .zip(split_at_cuts(pair_detail, pair_cuts))
+                    .zip(split_at_cuts(pair_rolling, pair_cuts))
+                    .zip(split_at_cuts(flips, chunk_cuts))
+                    .zip(split_at_cuts(slots, slot_cuts))
+                    .zip(split_at_cuts(wall_out, slot_cuts))
+                    .zip(split_at_cuts(wall_detail, slot_cuts))
                     .map(
                         |(((((((((p, a), k), o), d), r), on), s), wo), wd)| ForcePart {
                             pairs: p,
@@ -2368,13 +2368,13 @@ impl Simulation {
                 self.chunk_results.clear();
                 self.chunk_results
                     .resize(cuts.len() + 1, (0.0, 0.0, false, 0));
-                let mut parts = split_at_cuts(&mut self.position, &cuts)
-                    .zip(split_at_cuts(&mut self.velocity, &cuts))
-                    .zip(split_at_cuts(&mut self.omega, &cuts))
-                    .zip(split_at_cuts(&mut self.contact_force_sum, &cuts))
-                    .zip(split_at_cuts(&mut self.coordination, &cuts))
-                    .zip(split_at_cuts(&mut self.wall_coordination, &cuts))
-                    .zip(split_at_cuts(&mut self.chunk_results, &result_cuts))
+                let mut parts = split_at_cuts(&mut self.position, cuts)
+                    .zip(split_at_cuts(&mut self.velocity, cuts))
+                    .zip(split_at_cuts(&mut self.omega, cuts))
+                    .zip(split_at_cuts(&mut self.contact_force_sum, cuts))
+                    .zip(split_at_cuts(&mut self.coordination, cuts))
+                    .zip(split_at_cuts(&mut self.wall_coordination, cuts))
+                    .zip(split_at_cuts(&mut self.chunk_results, result_cuts))
                     .enumerate()
                     .peekable();
                 let (slots, outs) = (&self.wall_slots, &self.wall_out);

@@ -1245,7 +1245,7 @@ pub(super) fn pair_chunk_batched<const E: u16, const U: bool>(
                 base = next;
                 next = (base + 64).min(len);
                 for (bit, &w) in wake[base..next].iter().enumerate() {
-                    awake |= u64::from(!(travel < w)) << bit;
+                    awake |= (u64::from(travel < w) ^ 1) << bit;
                 }
                 continue;
             }
