@@ -94,6 +94,44 @@ fn one_and_two_threads_are_bitwise_identical() {
 }
 
 #[test]
+fn the_phase_clock_reads_each_threads_time_and_changes_nothing() {
+    let mut a = packed_soft(2);
+    let mut b = packed_soft(2);
+    assert!(b.phase_times().is_empty(), "the clock is off by default");
+    b.set_phase_timing(true);
+    let start = std::time::Instant::now();
+    a.step(500).unwrap();
+    b.step(500).unwrap();
+    let elapsed = start.elapsed().as_secs_f64();
+    assert_eq!(bits(&a), bits(&b), "the clock changed the results");
+    let times = b.phase_times();
+    assert_eq!(times.len(), 2, "one entry per thread");
+    for [force, particle] in &times {
+        // each phase ran on every step, and no phase took longer than the two runs together
+        assert!(
+            *force > 0.0 && *force < elapsed,
+            "force phase {force} s of {elapsed} s"
+        );
+        assert!(
+            *particle > 0.0 && *particle < elapsed,
+            "particle phase {particle} s of {elapsed} s"
+        );
+    }
+    // restarting the clock starts from zero; turning it off empties it
+    b.set_phase_timing(true);
+    assert!(b.phase_times().iter().all(|t| t == &[0.0, 0.0]));
+    b.set_phase_timing(false);
+    assert!(b.phase_times().is_empty());
+    // one thread: one entry, both phases timed
+    let mut c = packed_soft(1);
+    c.set_phase_timing(true);
+    c.step(100).unwrap();
+    let one = c.phase_times();
+    assert_eq!(one.len(), 1);
+    assert!(one[0][0] > 0.0 && one[0][1] > 0.0, "{one:?}");
+}
+
+#[test]
 fn avx2_and_baseline_kernels_are_bitwise_identical() {
     let mut a = packed_soft(1);
     let mut b = packed_soft(2);
