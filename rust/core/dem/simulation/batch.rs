@@ -1229,8 +1229,9 @@ pub(super) fn pair_chunk_batched<const E: u16, const U: bool>(
     let (velocity, omega, radius) = (&c.velocity[..n], &c.omega[..n], &c.radius[..n]);
     // the pairs to test, 64 at a time: bit b of `awake` is pair `base + b`, set unless the
     // pair is out of contact and cannot have closed its gap yet. Walking the set bits
-    // replaces a branch per pair that went either way at random in pair order (in the
-    // anchors' packed table, 40 % of the candidates sleep), and so was mispredicted often.
+    // replaces a branch per pair that goes either way at random in pair order (in the
+    // anchors' packed table 40 % of the candidates sleep; callgrind's branch simulator
+    // mispredicted 42 % of those branches, the step gained 1.2 % without them, stop 19)
     let (mut next, mut base, mut awake) = (0usize, 0usize, 0u64);
     while next < len || awake != 0 {
         // ---- find the pairs in contact (and end the contacts that stopped)
