@@ -66,8 +66,9 @@ use batch::{pair_chunk_batched, wall_chunk_batched, Batch, BATCH, BATCH_SCRATCH}
 /// Below this many particles the step runs on the calling thread whatever `threads` says:
 /// a rayon fork-join costs microseconds, as much as the whole step of a small system.
 pub const PARALLEL_MIN_PARTICLES: usize = 256;
-/// Pairs per kernel call (onsets and ends are counted per chunk, so the onset log and the
-/// gather lists find them without a full scan).
+/// Pairs per onset count: onsets and ends are counted per chunk of this many pairs, so the
+/// onset log and the gather lists find them without a full scan. A thread's block of pairs
+/// starts at a multiple of it. The kernels take a whole block in one call.
 const PAIR_CHUNK: usize = 256;
 /// The batched pair kernel skips a pair out of contact only while it cannot touch for at
 /// least this many steps at the last step's speed (see [`wake_travel`]).
@@ -457,7 +458,7 @@ struct PairCtx<'a> {
     pairs_hertz: bool,
     /// Every pair indexes the same Hertz entry of `table` and every particle has the same
     /// radius (m): (entry, radius). The batched pair kernel then writes the constants and
-    /// radii into its batch once per chunk instead of once per contact.
+    /// radii into its batch once per call instead of once per contact.
     pairs_uniform: Option<(u32, f64)>,
     /// The travel bound of this force evaluation, m (see [`Simulation::travel`]).
     travel: f64,
@@ -539,8 +540,8 @@ struct Flips {
     ends: u32,
 }
 
-/// The per-pair arrays of one chunk of the pair list that the pair kernels write, cut to
-/// the chunk (index e = pair − chunk start).
+/// The per-pair arrays of one block of the pair list that the pair kernels write, cut to
+/// the block (index e = pair − block start).
 struct PairLists<'a> {
     /// In contact at the last force evaluation.
     active: &'a mut [bool],
@@ -960,20 +961,24 @@ fn pair_kernel<const E: u16>(
     }
 }
 
-/// Pair kernels of one chunk of the pair list; returns the contacts begun and ended.
+/// Pair kernels of one block of the pair list (starting at a multiple of `PAIR_CHUNK`); the
+/// contacts begun and ended are added to `flips`, one entry per `PAIR_CHUNK` pairs.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn pair_chunk<const E: u16>(
     chunk: &mut [PairContact],
     lists: PairLists<'_>,
     konst: &[u32],
+    flips: &mut [Flips],
     c: &PairCtx<'_>,
     batch: &mut Batch,
-) -> Flips {
+) {
     if c.batched && !on::<E>(c.effects, Effect::RollingResistance) {
         return match c.pairs_uniform {
-            Some(_) if c.avx2 => pair_chunk_batched::<E, true>(chunk, lists, konst, c, batch),
-            _ => pair_chunk_batched::<E, false>(chunk, lists, konst, c, batch),
+            Some(_) if c.avx2 => {
+                pair_chunk_batched::<E, true>(chunk, lists, konst, flips, c, batch)
+            }
+            _ => pair_chunk_batched::<E, false>(chunk, lists, konst, flips, c, batch),
         };
     }
     // one at a time: every pair is tested (its wake stays a valid bound, see
@@ -985,20 +990,21 @@ fn pair_chunk<const E: u16>(
         rolling,
         ..
     } = lists;
-    let mut flips = Flips::default();
-    for (((((p, a), o), d), r), k) in chunk
+    for (e, (((((p, a), o), d), r), k)) in chunk
         .iter_mut()
         .zip(active.iter_mut())
         .zip(out.iter_mut())
         .zip(detail.iter_mut())
         .zip(rolling.iter_mut())
         .zip(konst)
+        .enumerate()
     {
         let f = pair_kernel::<E>(p, a, &c.table[*k as usize], o, d, r, c);
-        flips.onsets += f.onsets;
-        flips.ends += f.ends;
+        if let Some(chunk_flips) = flips.get_mut(e / PAIR_CHUNK) {
+            chunk_flips.onsets += f.onsets;
+            chunk_flips.ends += f.ends;
+        }
     }
-    flips
 }
 
 /// The kernel entry points ([`pair_chunk`], [`wall_chunk`], [`particle_chunk`]) compiled a
@@ -1039,9 +1045,10 @@ mod simd {
         chunk: &mut [PairContact],
         lists: PairLists<'_>,
         konst: &[u32],
+        flips: &mut [Flips],
         c: &PairCtx<'_>,
         batch: &mut Batch
-    ) -> Flips);
+    ) -> ());
 
     avx2_dispatch!(wall, wall_chunk_avx2, wall_chunk, (
         c: &WallCtx<'_>,
@@ -2208,33 +2215,6 @@ impl Simulation {
                 wall_state: &self.wall_state,
                 wall_stride: stride,
             };
-            type PairChunk<'c> = (
-                (
-                    (
-                        (
-                            ((&'c mut [PairContact], &'c mut [bool]), &'c mut [f64]),
-                            &'c mut [PairOut],
-                        ),
-                        &'c mut [PairDetail],
-                    ),
-                    &'c mut [Vec3],
-                ),
-                &'c [u32],
-            );
-            let kernel = |((((((chunk, active), wake), out), detail), rolling), konst): PairChunk<
-                '_,
-            >|
-             -> Flips {
-                let lists = PairLists {
-                    active,
-                    wake,
-                    out,
-                    detail,
-                    rolling,
-                };
-                BATCH_SCRATCH
-                    .with_borrow_mut(|b| simd::pair::<E>(avx2, chunk, lists, konst, &pair_ctx, b))
-            };
             let (pairs, pair_out, pair_const) =
                 (&mut self.pairs, &mut self.pair_out, &self.pair_const);
             let (pair_detail, pair_rolling) = (&mut self.pair_detail, &mut self.pair_rolling);
@@ -2249,19 +2229,14 @@ impl Simulation {
             let run = |(t, part): (usize, ForcePart<'_>)| {
                 let start = (!clock.is_empty()).then(std::time::Instant::now);
                 let (first_particle, first_pair) = if t == 0 { (0, 0) } else { cut[t - 1] };
+                // the block's pairs in one call: the batches run on across the chunks of
+                // `PAIR_CHUNK` pairs (whose onsets and ends are counted apart), so only the
+                // block's last batch is partial
                 let konst = &pair_const[first_pair..first_pair + part.pairs.len()];
-                let chunks = part
-                    .pairs
-                    .chunks_mut(PAIR_CHUNK)
-                    .zip(part.lists.active.chunks_mut(PAIR_CHUNK))
-                    .zip(part.lists.wake.chunks_mut(PAIR_CHUNK))
-                    .zip(part.lists.out.chunks_mut(PAIR_CHUNK))
-                    .zip(part.lists.detail.chunks_mut(PAIR_CHUNK))
-                    .zip(part.lists.rolling.chunks_mut(PAIR_CHUNK))
-                    .zip(konst.chunks(PAIR_CHUNK));
-                for (slot, chunk) in part.flips.iter_mut().zip(chunks) {
-                    *slot = kernel(chunk);
-                }
+                let (pairs, lists, flips) = (part.pairs, part.lists, part.flips);
+                BATCH_SCRATCH.with_borrow_mut(|b| {
+                    simd::pair::<E>(avx2, pairs, lists, konst, flips, &pair_ctx, b)
+                });
                 let block = match (wall_lists.cuts.get(t), wall_lists.cuts.get(t + 1)) {
                     (Some(a), Some(b)) => BlockWalls {
                         planes: &wall_lists.planes[a.0..b.0],
