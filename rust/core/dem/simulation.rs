@@ -12,7 +12,7 @@
 //!    instruction, the same operations per lane: `batch::advance4`).
 //!
 //! With several threads, the particles are cut into one contiguous block per thread (at
-//! rebuild, `part_cuts`); in the force phase a thread takes the pairs whose first particle is
+//! rebuild, `cut_lists`); in the force phase a thread takes the pairs whose first particle is
 //! in its block and the block's wall slots, in the particle phase it advances the block. The
 //! calling thread always runs block 0, so most of what a thread writes in one phase it reads
 //! itself in the next, from its own core's cache, instead of rayon's work stealing moving
@@ -381,12 +381,7 @@ pub struct Simulation {
     /// The pairs in which particle i is the first particle are
     /// `pairs[pair_start[i]..pair_start[i + 1]]` (the list is sorted by (i, j)).
     pub(crate) pair_start: Vec<u32>,
-    /// Where the parallel step splits its work, one (particle, pair) index per boundary
-    /// between consecutive threads' blocks: particle boundaries at multiples of
-    /// `PARTICLE_CHUNK`, pair boundaries (the first pair whose i is in the next block,
-    /// rounded) at multiples of `PAIR_CHUNK`.
-    part_cuts: Vec<(usize, usize)>,
-    /// `part_cuts` as the parallel step cuts its arrays (see [`CutLists`]).
+    /// Where the parallel step splits its work into the threads' blocks (see [`CutLists`]).
     cut_lists: CutLists,
     /// The wall slots of the batched kernels, listed once per neighbour list (see
     /// [`Simulation::list_wall_slots`]).
@@ -553,13 +548,16 @@ struct PairLists<'a> {
 }
 
 /// The positions at which the parallel step cuts each kind of array into the threads'
-/// blocks, derived from `Simulation::part_cuts` and the wall stride when those change rather
-/// than collected in every step (seven allocations per step on two threads).
+/// blocks, one per boundary between consecutive blocks. `particle` and `pair` are set with
+/// the gather lists; the others are derived from them and the wall stride when those change
+/// (`Simulation::derive_cut_lists`), not collected in every step (seven allocations per step
+/// on two threads).
 #[derive(Debug, Default)]
 struct CutLists {
-    /// Particle arrays.
+    /// Particle arrays: at multiples of `PARTICLE_CHUNK`.
     particle: Vec<usize>,
-    /// Pair arrays.
+    /// Pair arrays: the first pair whose i is in the next block, rounded to a multiple of
+    /// `PAIR_CHUNK`.
     pair: Vec<usize>,
     /// The pair chunks' onset counts (a pair cut is a multiple of `PAIR_CHUNK` or the end of
     /// the list).
@@ -570,7 +568,7 @@ struct CutLists {
     block: Vec<usize>,
 }
 
-/// One thread's block of the parallel force phase (see `Simulation::part_cuts`).
+/// One thread's block of the parallel force phase (see [`CutLists`]).
 struct ForcePart<'a> {
     pairs: &'a mut [PairContact],
     /// The block's pair arrays (cut into chunks for the kernels).
@@ -1654,7 +1652,6 @@ impl Simulation {
             travel: 0.0,
             travel_slack: 0.0,
             travel_step: 0.0,
-            part_cuts: Vec::new(),
             cut_lists: CutLists::default(),
             wall_lists: WallLists::default(),
             pair_out: Vec::new(),
@@ -1773,7 +1770,9 @@ impl Simulation {
             self.pair_start[i + 1] += self.pair_start[i];
             self.active_base[i + 1] += self.active_base[i];
         }
-        self.part_cuts.clear();
+        let cuts = &mut self.cut_lists;
+        cuts.particle.clear();
+        cuts.pair.clear();
         let parts = self.threads.max(1);
         let mut last = (0usize, 0usize);
         for t in 1..parts {
@@ -1781,7 +1780,8 @@ impl Simulation {
             let p = round(n * t / parts, PARTICLE_CHUNK).clamp(last.0, n);
             let e = round(self.pair_start[p] as usize, PAIR_CHUNK).clamp(last.1, self.pairs.len());
             last = (p, e);
-            self.part_cuts.push(last);
+            cuts.particle.push(p);
+            cuts.pair.push(e);
         }
         // the gather lists of the pairs in contact, in increasing pair order
         self.active_entry.clear();
@@ -1856,24 +1856,26 @@ impl Simulation {
         }
     }
 
-    /// Derived per-contact data: r_i + r_j of each pair, the law constants of every pair
-    /// and wall slot, and the wall slots' output arrays. A pure function of the lists and the
-    /// static data (run after a rebuild and a restore).
-    pub(crate) fn refresh_contact_constants(&mut self) {
+    /// The cut positions of [`CutLists`] that follow from its particle and pair cuts and the
+    /// wall stride.
+    fn derive_cut_lists(&mut self) {
         let stride = self.wall_stride;
         let cuts = &mut self.cut_lists;
-        let part_cuts = &self.part_cuts;
-        cuts.particle.clear();
-        cuts.particle.extend(part_cuts.iter().map(|c| c.0));
-        cuts.pair.clear();
-        cuts.pair.extend(part_cuts.iter().map(|c| c.1));
         cuts.chunk.clear();
         cuts.chunk
-            .extend(part_cuts.iter().map(|c| c.1.div_ceil(PAIR_CHUNK)));
+            .extend(cuts.pair.iter().map(|e| e.div_ceil(PAIR_CHUNK)));
         cuts.slot.clear();
-        cuts.slot.extend(part_cuts.iter().map(|c| c.0 * stride));
+        cuts.slot.extend(cuts.particle.iter().map(|p| p * stride));
         cuts.block.clear();
-        cuts.block.extend(1..=part_cuts.len());
+        cuts.block.extend(1..=cuts.particle.len());
+    }
+
+    /// Derived per-contact data: r_i + r_j of each pair, the law constants of every pair
+    /// and wall slot, the wall slots' output arrays, and the derived cut positions of the
+    /// threads' blocks. A pure function of the lists and the static data (run after a
+    /// rebuild and a restore).
+    pub(crate) fn refresh_contact_constants(&mut self) {
+        self.derive_cut_lists();
         self.wall_lists.mode = None;
         let n_slots = self.wall_slots.len();
         self.wall_out.clear();
@@ -1936,7 +1938,7 @@ impl Simulation {
     }
 
     /// The [`WallLists`] for the step's mode: per block of the force phase (`parallel`: the
-    /// blocks of `part_cuts`, else one), the groups of the AVX2 plane pass (four
+    /// blocks of `cut_lists`, else one), the groups of the AVX2 plane pass (four
     /// consecutive alive particles from the block's start, a slot column whose four slots
     /// hold the same plane wall with Hertz constants; marked `planar_pass`) and every other
     /// slot of an alive particle. Without AVX2 there are no groups. A pure function of the
@@ -1955,7 +1957,7 @@ impl Simulation {
         let mut plane_const: Option<Option<u32>> = Some(None);
         let mut ends = vec![0];
         if parallel {
-            ends.extend(self.part_cuts.iter().map(|c| c.0));
+            ends.extend(&self.cut_lists.particle);
         }
         ends.push(n);
         let slots = &mut self.wall_slots;
@@ -2221,14 +2223,17 @@ impl Simulation {
             let (pair_active, pair_wake) = (&mut self.pair_active, &mut self.pair_wake);
             let (flips, slots) = (&mut self.chunk_flips, &mut self.wall_slots);
             let (wall_out, wall_detail) = (&mut self.wall_out, &mut self.wall_detail);
-            let cut = &self.part_cuts;
+            let cut = &self.cut_lists;
             let wall_lists = &self.wall_lists;
             flips.clear();
             flips.resize(pairs.len().div_ceil(PAIR_CHUNK), Flips::default());
             let clock = &self.phase_clock;
             let run = |(t, part): (usize, ForcePart<'_>)| {
                 let start = (!clock.is_empty()).then(std::time::Instant::now);
-                let (first_particle, first_pair) = if t == 0 { (0, 0) } else { cut[t - 1] };
+                let (first_particle, first_pair) = match t.checked_sub(1) {
+                    Some(b) => (cut.particle[b], cut.pair[b]),
+                    None => (0, 0),
+                };
                 // the block's pairs in one call: the batches run on across the chunks of
                 // `PAIR_CHUNK` pairs (whose onsets and ends are counted apart), so only the
                 // block's last batch is partial
