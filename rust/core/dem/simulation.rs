@@ -1265,6 +1265,26 @@ impl Sum3 {
         self.z += v.z * s;
     }
 
+    /// Adds v with its sign bits flipped by `flip` (0 or the sign bit): bitwise v times +1.0
+    /// or −1.0 (multiplying by ±1 is exact), without the multiply.
+    #[inline(always)]
+    fn add_flipped(&mut self, flip: u64, v: Vec3) {
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: SSE2 is part of the x86_64 baseline.
+        unsafe {
+            use std::arch::x86_64::*;
+            let m = _mm_castsi128_pd(_mm_set1_epi64x(flip as i64));
+            self.xy = _mm_add_pd(self.xy, _mm_xor_pd(_mm_setr_pd(v.x, v.y), m));
+            self.z += _mm_cvtsd_f64(_mm_xor_pd(_mm_set_sd(v.z), m));
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            let f = |x: f64| f64::from_bits(x.to_bits() ^ flip);
+            self.xy = (self.xy.0 + f(v.x), self.xy.1 + f(v.y));
+            self.z += f(v.z);
+        }
+    }
+
     /// Adds v.
     #[inline(always)]
     fn add(&mut self, v: Vec3) {
@@ -1348,15 +1368,15 @@ impl Gather<'_> {
             let Some(p) = pair_out.get(e) else {
                 continue;
             };
-            // +1.0 for the first particle (a odd), −1.0 for the second: the sign bit
-            let sign = f64::from_bits(1.0f64.to_bits() | (u64::from(!a & 1) << 63));
+            // + for the first particle (a odd), − for the second: the sign bit flipped
+            let flip = u64::from(!a & 1) << 63;
             z += 1;
-            f.add_scaled(sign, p.force);
+            f.add_flipped(flip, p.force);
             if rotation {
                 let arm = radius[k] - 0.5 * p.overlap;
                 t.add_scaled(arm, p.torque_per_arm);
                 if rolling {
-                    t.add_scaled(sign, pair_rolling[e]);
+                    t.add_flipped(flip, pair_rolling[e]);
                 }
             }
         }
