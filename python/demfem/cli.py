@@ -15,29 +15,32 @@ __all__ = ["main", "build_parser", "study_options_from_args"]
 def _cmd_calibrate(args: argparse.Namespace) -> int:
     from demfem.calibration import force_vs_modulus, write_calibration
     from demfem.cartridge import Cartridge
-    from demfem.contact import ContactBody, hertz_contact_duration, rayleigh_time_step
+    from demfem.pipeline import calibration_report
 
-    cart = Cartridge()
-    sphere = cart.equivalent_sphere()
-    body = ContactBody.from_cartridge(cart)
-    mp = cart.mass_properties()
-    print("Default cartridge (3 mL, ISO 13926-1 style), glass:", cart.material.name)
-    print(f"  glass volume        {cart.glass_volume * 1e9:10.1f} mm^3")
-    print(f"  mass                {cart.mass * 1e3:10.3f} g")
-    print(f"  centre of mass z    {mp.center_of_mass[2] * 1e3:10.2f} mm from the open end")
-    print(f"  inertia (Ixx, Izz)  {mp.inertia[0, 0]:10.3e} {mp.inertia[2, 2]:10.3e} kg m^2")
-    print(f"  equivalent sphere   {sphere.diameter * 1e3:10.2f} mm diameter")
-    print(f"  Reissner k_R        {body.k_reissner:10.3e} N/m (t = {cart.wall_thickness*1e3:g} mm,"
-          f" R = {cart.body_mid_radius*1e3:g} mm)")
-    print(f"  Hertz contact time  {hertz_contact_duration(body, body, args.v_rel)*1e6:10.2f} us"
-          f" at {args.v_rel:g} m/s")
-    print(f"  Rayleigh time step  {rayleigh_time_step(sphere.radius, cart.material.E, cart.material.nu, cart.material.density)*1e6:10.3f} us")
+    print(calibration_report(args.v_rel))
     E = np.logspace(np.log10(args.e_min), np.log10(args.e_max), args.n)
-    table = force_vs_modulus(cart, E, args.v_rel)
+    table = force_vs_modulus(Cartridge(), E, args.v_rel)
     print(f"\nMaximum contact force, two cartridges at v_rel = {args.v_rel:g} m/s (Fig. 3 analogue):")
     print(table.format())
     csv, png = write_calibration(args.out, table)
     print(f"\nwrote {csv}\nwrote {png}")
+    return 0
+
+
+def _cmd_run(args: argparse.Namespace) -> int:
+    from demfem.pipeline import run_pipeline
+    from demfem.progress import ProgressBar
+
+    duration = args.duration if args.duration is not None else (0.1 if args.quick else 1.0)
+    sample = args.sample_interval if args.sample_interval is not None else min(
+        0.01 if args.quick else 0.02, duration)
+    bar = ProgressBar(duration, label="table")
+    try:
+        run_pipeline(args.out, duration=duration, young_modulus=args.young_modulus,
+                     sample_interval=sample, threads=args.threads, progress=bar,
+                     log=lambda line: print(line, flush=True))
+    finally:
+        bar.close()
     return 0
 
 
@@ -168,6 +171,18 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--n", type=int, default=9, help="number of moduli, log-spaced (9)")
     c.add_argument("--out", default="demfem_out", help="output directory (demfem_out)")
     c.set_defaults(func=_cmd_calibrate)
+    r = sub.add_parser("run", help="the main job: calibration, DEM of the default table, analysis")
+    r.add_argument("--duration", type=float, default=None,
+                   help="simulated time of the table, s (1.0; --quick: 0.1)")
+    r.add_argument("--E", dest="young_modulus", type=float, default=None,
+                   help="Young's modulus of the glass, Pa (the paper's 4.5e10)")
+    r.add_argument("--sample-interval", type=float, default=None,
+                   help="time between recorded samples, s (0.02; --quick: 0.01)")
+    r.add_argument("--threads", type=int, default=1, help="DEM engine threads (1)")
+    r.add_argument("--quick", action="store_true", help="a smoke run with the same outputs")
+    r.add_argument("--out", default="demfem_out/run", help="output directory (demfem_out/run); "
+                   "an interrupted run resumes from its checkpoint there")
+    r.set_defaults(func=_cmd_run)
     s = sub.add_parser("sweep", help="run a parameter grid on Dask (LocalCluster by default)")
     s.add_argument("--runner", required=True,
                    help="'module:function' run per point, e.g. demfem.calibration:sweep_point")

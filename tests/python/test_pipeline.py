@@ -1,0 +1,87 @@
+"""`demfem run`: calibration, the DEM of the default table and its analysis, in one call.
+
+The short run is checked against closed forms: a sphere dropped on a belt of speed V ends up
+rolling at 2/7 V (its angular momentum about the contact line is conserved: m v r = I w with
+I = 2/5 m r^2 and v + w r = V), after sliding for (2/7 V) / (mu g); and a sphere alone on the
+belt carries its weight, so the first line's mean net contact force is m g.
+"""
+import csv
+import json
+
+import numpy as np
+import pytest
+
+from demfem.cli import main
+from demfem.errors import InvalidParameterError
+from demfem.pipeline import NOT_YET, run_pipeline
+from demfem.scenes.table import AccumulationTable, Tag
+from demfem.studies.table_run import TableRun
+
+
+@pytest.fixture(scope="module")
+def short_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("run")
+    lines = []
+    result = run_pipeline(out, duration=0.05, sample_interval=0.01, log=lines.append)
+    return out, result, "\n".join(lines)
+
+
+def test_a_sphere_on_the_belt_rolls_at_two_sevenths_of_the_belt_speed(short_run):
+    out, _, _ = short_run
+    run = TableRun.load(out / "table_run.npz")
+    table = AccumulationTable()
+    v_roll = 2.0 / 7.0 * table.belt_velocity
+    t_slide = v_roll / (table.friction * table.gravity)
+    assert t_slide < 0.04
+    k = int(np.argmin(np.abs(run.times - 0.04)))
+    rect = run.velocities[k, run.tags == Tag.RECTANGULAR_CENTRE]
+    assert np.allclose(rect[:, 0], v_roll, rtol=2e-3)
+    assert np.allclose(rect[:, 1:], 0.0, atol=1e-3 * v_roll)
+
+
+def test_the_first_line_carries_its_weight_before_the_pack_reaches_it(short_run):
+    out, _, _ = short_run
+    run = TableRun.load(out / "table_run.npz")
+    table = AccumulationTable()
+    k = int(np.argmin(np.abs(run.times - 0.04)))
+    assert run.first_line_force()[k] == pytest.approx(table.sphere_mass * table.gravity,
+                                                      rel=1e-2)
+
+
+def test_the_outputs_agree_with_each_other_and_say_what_is_missing(short_run):
+    out, result, text = short_run
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["not_yet"] == list(NOT_YET)
+    for stage in NOT_YET:
+        assert stage in text
+    assert "equivalent sphere" in text and "Fig. 3 analogue" in text
+    rows = list(csv.DictReader(open(out / "collisions.csv")))
+    assert len(rows) == summary["collisions"]["n_onsets"] > 0
+    speeds = np.array([float(r["normal_speed_m_s"]) for r in rows])
+    assert summary["collisions"]["normal_speed_m_s"][-1] == pytest.approx(speeds.max())
+    assert summary["collisions"]["normal_speed_m_s"][0] == pytest.approx(np.median(speeds))
+    cal = np.loadtxt(out / "calibration.csv", delimiter=",", skiprows=1)
+    assert np.allclose(cal[:, 1:5].T, summary["calibration"]["max_force_N"], rtol=1e-6)
+    for f in summary["files"]:
+        assert (out / f.split("/")[-1]).exists() or f.endswith(".pvd")
+    assert (out / "vtk" / "table.pvd").exists()
+    assert not (out / "table.ck").exists()  # the checkpoint goes once the run is done
+    for png in ("calibration_force_vs_E.png", "table_time_series.png", "collisions.png",
+                "table_end.png"):
+        assert (out / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize("field,kwargs", [
+    ("duration", {"duration": -1.0}),
+    ("duration", {"duration": float("nan")}),
+    ("sample_interval", {"duration": 0.1, "sample_interval": 0.2}),
+    ("discard_before", {"duration": 0.1, "discard_before": 0.5}),
+])
+def test_bad_input_names_the_field(tmp_path, field, kwargs):
+    with pytest.raises(InvalidParameterError, match=field):
+        run_pipeline(tmp_path, log=lambda _: None, **kwargs)
+
+
+def test_the_command_reports_bad_input(tmp_path, capsys):
+    assert main(["run", "--E", "-1", "--duration", "0.01", "--out", str(tmp_path)]) == 2
+    assert "young_modulus" in capsys.readouterr().err
