@@ -31,7 +31,9 @@ class ProgressBar:
     """A progress line for a run of ``duration`` seconds of simulated time.
 
     Call it as ``bar(sim_time, steps)`` with the simulated time reached (s) and the steps done
-    so far; call :meth:`close` at the end. ``width`` is the bar's width in characters.
+    so far; call :meth:`close` at the end. ``width`` is the bar's width in characters. The
+    rate and the ETA count from the first call, so neither the set-up before it nor the steps
+    of a resumed run's earlier part distort them; until a second call they read ``--``.
     """
 
     def __init__(self, duration: float, label: str = "run", stream: Optional[TextIO] = None,
@@ -44,26 +46,33 @@ class ProgressBar:
         self.interval = interval if self.tty else log_interval
         self._t0 = time.perf_counter()
         self._last_draw = -math.inf
-        self._steps0: Optional[int] = None
+        # wall time, steps and simulated time at the first call
+        self._first: Optional[tuple[float, int, float]] = None
         self.last_line = ""
 
     def line(self, sim_time: float, steps: int) -> str:
         """The text of the progress line for ``sim_time`` (s) and ``steps``."""
-        elapsed = time.perf_counter() - self._t0
+        now = time.perf_counter()
+        elapsed = now - self._t0
         frac = min(max(sim_time / self.duration, 0.0), 1.0)
         filled = int(round(frac * self.width))
         bar = "#" * filled + "-" * (self.width - filled)
-        steps_done = steps - (self._steps0 or 0)
-        rate = steps_done / elapsed if elapsed > 0 else float("nan")
-        eta = elapsed * (1.0 - frac) / frac if frac > 0 else float("nan")
+        rate = eta = math.nan
+        if self._first is not None:
+            t1, steps1, sim1 = self._first
+            wall, done = now - t1, sim_time - sim1
+            if wall > 0 and done > 0:
+                rate = (steps - steps1) / wall
+                eta = wall * max(self.duration - sim_time, 0.0) / done
+        rate_text = f"{rate:,.0f}" if math.isfinite(rate) else "--"
         return (f"{self.label} [{bar}] {100 * frac:5.1f}%  t = {sim_time:.4g}/{self.duration:.4g} s"
-                f"  {rate:,.0f} steps/s  elapsed {format_duration(elapsed)}"
+                f"  {rate_text} steps/s  elapsed {format_duration(elapsed)}"
                 f"  ETA {format_duration(eta)}")
 
     def __call__(self, sim_time: float, steps: int) -> None:
-        if self._steps0 is None:
-            self._steps0 = steps
         now = time.perf_counter()
+        if self._first is None:
+            self._first = (now, steps, sim_time)
         if now - self._last_draw < self.interval and sim_time < self.duration:
             return
         self._last_draw = now
