@@ -29,18 +29,13 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
 
 def _cmd_run(args: argparse.Namespace) -> int:
     from demfem.pipeline import run_pipeline
-    from demfem.progress import ProgressBar
 
     duration = args.duration if args.duration is not None else (0.1 if args.quick else 1.0)
     sample = args.sample_interval if args.sample_interval is not None else min(
         0.01 if args.quick else 0.02, duration)
-    bar = ProgressBar(duration, label="table")
-    try:
-        run_pipeline(args.out, duration=duration, young_modulus=args.young_modulus,
-                     sample_interval=sample, threads=args.threads, progress=bar,
-                     log=lambda line: print(line, flush=True))
-    finally:
-        bar.close()
+    run_pipeline(args.out, duration=duration, young_modulus=args.young_modulus,
+                 sample_interval=sample, threads=args.threads, progress=True,
+                 log=lambda line: print(line, flush=True))
     return 0
 
 

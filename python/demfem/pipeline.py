@@ -83,7 +83,7 @@ def run_pipeline(out: str | Path = "demfem_out/run", duration: float = 1.0,
                  young_modulus: Optional[float] = None, sample_interval: float = 0.02,
                  threads: int = 1, v_rel: float = 0.2, discard_before: Optional[float] = None,
                  log: Callable[[str], None] = print,
-                 progress: Optional[Callable[[float, int], None]] = None) -> dict[str, Any]:
+                 progress: bool | Callable[[float, int], None] = False) -> dict[str, Any]:
     """Run calibration, the DEM of the default table and its analysis; write the outputs.
 
     Args:
@@ -96,7 +96,8 @@ def run_pipeline(out: str | Path = "demfem_out/run", duration: float = 1.0,
         discard_before: start of the force and coordination statistics, s (default: half
             the run, after the pack has begun to form).
         log: where the report's lines go.
-        progress: callback ``progress(sim_time_s, steps)`` of the table run.
+        progress: callback ``progress(sim_time_s, steps)`` of the table run, or ``True`` for
+            a :class:`demfem.progress.ProgressBar` on standard error started with the run.
 
     Returns:
         The summary (also written to ``summary.json``): calibration, the run's numbers,
@@ -132,8 +133,16 @@ def run_pipeline(out: str | Path = "demfem_out/run", duration: float = 1.0,
     # 2. DEM of the table
     log(f"\n== 2. DEM: the accumulation table, {table.n_spheres} spheres, "
         f"E = {table.young_modulus:.3g} Pa, {duration:g} s ==")
-    run = run_table(table, duration, sample_interval, threads=threads, progress=progress,
-                    checkpoint=out / "table.ck", checkpoint_every=60.0)
+    from demfem.progress import ProgressBar
+
+    bar = ProgressBar(duration, label="table") if progress is True else None
+    callback = bar if bar is not None else (progress if callable(progress) else None)
+    try:
+        run = run_table(table, duration, sample_interval, threads=threads, progress=callback,
+                        checkpoint=out / "table.ck", checkpoint_every=60.0)
+    finally:
+        if bar is not None:
+            bar.close()
     run_path = run.save(out / "table_run.npz")
     info = run.info
     log(f"  {info['steps']} steps of {info['dt']:.3g} s in {info['wall_time_s']:.1f} s wall "
