@@ -246,6 +246,7 @@ def run_pipeline(out: str | Path = "demfem_out/run", duration: float = 1.0,
     }
     summary_path = write_text_atomic(out / "summary.json",
                                      json.dumps(result, indent=1, default=float) + "\n")
-    log(f"\nwritten to {out}: " + ", ".join(Path(p).name for p in result["files"])
+    log(f"\nwritten to {out}: " + ", ".join(str(Path(p).relative_to(out))
+                                          for p in result["files"])
         + f", {summary_path.name}")
     return result
