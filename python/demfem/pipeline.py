@@ -32,7 +32,7 @@ from typing import Any, Callable, Optional
 
 import numpy as np
 
-from demfem.errors import InvalidParameterError
+from demfem.errors import InvalidParameterError, SimulationInterrupted
 
 __all__ = ["calibration_report", "run_pipeline", "NOT_YET"]
 
@@ -82,6 +82,7 @@ def _check(name: str, value: float, lo: float, hi: float = math.inf) -> float:
 def run_pipeline(out: str | Path = "demfem_out/run", duration: float = 1.0,
                  young_modulus: Optional[float] = None, sample_interval: float = 0.02,
                  threads: int = 1, v_rel: float = 0.2, discard_before: Optional[float] = None,
+                 checkpoint_every: float = 15.0,
                  log: Callable[[str], None] = print,
                  progress: bool | Callable[[float, int], None] = False) -> dict[str, Any]:
     """Run calibration, the DEM of the default table and its analysis; write the outputs.
@@ -95,6 +96,8 @@ def run_pipeline(out: str | Path = "demfem_out/run", duration: float = 1.0,
         v_rel: relative impact speed of the calibration's two cartridges, m/s.
         discard_before: start of the force and coordination statistics, s (default: half
             the run, after the pack has begun to form).
+        checkpoint_every: wall time between checkpoints of the table run, s. An interrupted
+            job (Ctrl-C) started again with the same arguments resumes from the last one.
         log: where the report's lines go.
         progress: callback ``progress(sim_time_s, steps)`` of the table run, or ``True`` for
             a :class:`demfem.progress.ProgressBar` on standard error started with the run.
@@ -139,7 +142,19 @@ def run_pipeline(out: str | Path = "demfem_out/run", duration: float = 1.0,
     callback = bar if bar is not None else (progress if callable(progress) else None)
     try:
         run = run_table(table, duration, sample_interval, threads=threads, progress=callback,
-                        checkpoint=out / "table.ck", checkpoint_every=60.0)
+                        checkpoint=out / "table.ck", checkpoint_every=checkpoint_every)
+    except SimulationInterrupted:
+        if bar is not None:
+            bar.close()
+            bar = None
+        saved = out / "table.ck.json"
+        if saved.exists() and "sim_time_s" in (state := json.loads(saved.read_text())):
+            log(f"interrupted: started again with the same arguments, the job resumes from "
+                f"its checkpoint at t = {state['sim_time_s']:.4g} s ({out / 'table.ck'})")
+        else:
+            log(f"interrupted before the first checkpoint (every {checkpoint_every:g} s of "
+                "wall time): nothing to resume")
+        raise
     finally:
         if bar is not None:
             bar.close()

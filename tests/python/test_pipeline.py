@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from demfem.cli import main
-from demfem.errors import InvalidParameterError
+from demfem.errors import InvalidParameterError, SimulationInterrupted
 from demfem.pipeline import NOT_YET, run_pipeline
 from demfem.scenes.table import AccumulationTable, Tag
 from demfem.studies.table_run import TableRun
@@ -73,6 +73,29 @@ def test_the_outputs_agree_with_each_other_and_say_what_is_missing(short_run):
     for png in ("calibration_force_vs_E.png", "table_time_series.png", "collisions.png",
                 "table_end.png"):
         assert (out / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_an_interrupted_job_resumes_and_ends_as_an_uninterrupted_one(short_run, tmp_path):
+    _, whole, _ = short_run
+    lines = []
+
+    def ctrl_c(sim_time, steps):
+        if sim_time > 0.025:
+            raise SimulationInterrupted(f"interrupted at t = {sim_time} s after {steps} steps")
+
+    with pytest.raises(SimulationInterrupted):
+        run_pipeline(tmp_path, duration=0.05, sample_interval=0.01, log=lines.append,
+                     progress=ctrl_c, checkpoint_every=1e-9)
+    assert "resumes from its checkpoint at t = 0.02 s" in lines[-1]
+    assert not (tmp_path / "summary.json").exists()
+    seen = []
+    resumed = run_pipeline(tmp_path, duration=0.05, sample_interval=0.01,
+                           log=lambda _: None, progress=lambda t, steps: seen.append(t))
+    assert min(seen) > 0.025  # resumed after the checkpoint at 0.02 s, not started afresh
+    for key in ("force_mean_N", "force_peak_N", "coordination_mean", "max_overlap_m",
+                "n_onsets", "triangular_centre_mean_speed_mm_s"):
+        assert resumed["table"][key] == whole["table"][key]
+    assert resumed["collisions"] == whole["collisions"]
 
 
 @pytest.mark.parametrize("field,kwargs", [

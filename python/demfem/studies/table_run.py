@@ -418,7 +418,8 @@ def _write_checkpoint(sim, rec: _Recorder, files: tuple[Path, Path, Path],
     rec.save_partial(record_file.with_name(record_file.name + ".new.npz"))
     os.replace(tmp_ckpt, ckpt)
     os.replace(record_file.with_name(record_file.name + ".new.npz"), record_file)
-    write_text_atomic(wall_file, json.dumps({"wall_time_s": wall_time}))
+    write_text_atomic(wall_file, json.dumps({"wall_time_s": wall_time,
+                                             "sim_time_s": float(sim.time)}))
 
 
 # --------------------------------------------------------------------------------------------
