@@ -32,7 +32,7 @@ from typing import Any, Callable, Optional
 
 import numpy as np
 
-from demfem.errors import InvalidParameterError, SimulationInterrupted
+from demfem.errors import InvalidParameterError, SimulationInterrupted, check_positive
 
 __all__ = ["calibration_report", "run_pipeline", "NOT_YET"]
 
@@ -92,7 +92,7 @@ def run_pipeline(out: str | Path = "demfem_out/run", duration: float = 1.0,
         duration: simulated time of the table run, s.
         young_modulus: Young's modulus of the glass, Pa (default: the paper's 45 GPa).
         sample_interval: time between recorded samples, s.
-        threads: DEM engine threads.
+        threads: DEM engine threads (results are bitwise the same on any number).
         v_rel: relative impact speed of the calibration's two cartridges, m/s.
         discard_before: start of the force and coordination statistics, s (default: half
             the run, after the pack has begun to form).
@@ -114,10 +114,11 @@ def run_pipeline(out: str | Path = "demfem_out/run", duration: float = 1.0,
     from demfem.plots import plot_table_snapshot
     from demfem.scenes.table import AccumulationTable, Tag
     from demfem.studies.figures import _write_vtk_series
-    from demfem.studies.table_run import run_table
+    from demfem.studies.table_run import _check_run_arguments, run_table
 
-    duration = _check("duration", duration, 0.0)
-    sample_interval = _check("sample_interval", sample_interval, 0.0, duration)
+    # every argument checked before any work
+    _check_run_arguments(duration, sample_interval, threads)
+    v_rel = check_positive("v_rel", v_rel)
     discard = 0.5 * duration if discard_before is None else _check(
         "discard_before", discard_before, -math.inf, duration)
     table = AccumulationTable() if young_modulus is None else AccumulationTable(

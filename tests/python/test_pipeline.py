@@ -103,10 +103,15 @@ def test_an_interrupted_job_resumes_and_ends_as_an_uninterrupted_one(short_run, 
     ("duration", {"duration": float("nan")}),
     ("sample_interval", {"duration": 0.1, "sample_interval": 0.2}),
     ("discard_before", {"duration": 0.1, "discard_before": 0.5}),
+    ("threads", {"duration": 0.1, "threads": 0}),
+    ("v_rel", {"duration": 0.1, "v_rel": -0.2}),
+    ("young_modulus", {"duration": 0.1, "young_modulus": float("nan")}),
 ])
 def test_bad_input_names_the_field(tmp_path, field, kwargs):
+    lines = []
     with pytest.raises(InvalidParameterError, match=field):
-        run_pipeline(tmp_path, log=lambda _: None, **kwargs)
+        run_pipeline(tmp_path / "out", log=lines.append, **kwargs)
+    assert lines == [] and not (tmp_path / "out").exists()  # refused before any work
 
 
 def test_the_command_reports_bad_input(tmp_path, capsys):
