@@ -24,6 +24,8 @@ import sys
 import tempfile
 import time
 
+from demfem.io.atomic import write_text_atomic
+
 # Issue 5's targets for the packed state, and the anchors' speeds on the machine where they
 # were set (a 2-core machine; particle-steps/s, one process each)
 TARGET_RATE = {1: 1.5e7, 2: 2.5e7}
@@ -123,16 +125,6 @@ def target_report(per_rep: dict[str, list[float]], demfem_rate: dict[int, float]
     return lines
 
 
-def write_json_atomic(path: str, data) -> None:
-    """Write ``data`` as JSON to ``path`` through a temporary file and a rename."""
-    tmp = f"{path}.tmp{os.getpid()}"
-    with open(tmp, "w") as f:
-        json.dump(data, f, indent=1)
-        f.flush()
-        os.fsync(f.fileno())
-    os.replace(tmp, path)
-
-
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--E", type=float, default=45e9)
@@ -211,7 +203,7 @@ def main() -> None:
         for line in target_report(one_thread, ours, theirs):
             print(line)
     if a.json:
-        write_json_atomic(a.json, rows)
+        write_text_atomic(a.json, json.dumps(rows, indent=1))
 
 
 if __name__ == "__main__":

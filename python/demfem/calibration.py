@@ -12,11 +12,12 @@ from typing import Optional, Sequence
 import numpy as np
 
 from demfem.cartridge import Cartridge
-from demfem.contact import MODELS, ContactBody, k_eq, max_contact_force
+from demfem.contact import (MODELS, ContactBody, hertz_contact_duration, k_eq,
+                            max_contact_force, rayleigh_time_step)
 from demfem.errors import check_positive
 from demfem.io import savefig_atomic, write_text_atomic
 
-__all__ = ["CalibrationTable", "force_vs_modulus", "plot_force_vs_modulus"]
+__all__ = ["CalibrationTable", "calibration_report", "force_vs_modulus", "plot_force_vs_modulus"]
 
 
 @dataclass(frozen=True)
@@ -101,6 +102,31 @@ def plot_force_vs_modulus(table: CalibrationTable, path: "str | Path",
     out = savefig_atomic(fig, path, dpi=130)
     plt.close(fig)
     return out
+
+
+def calibration_report(v_rel: float = 0.2) -> str:
+    """The equivalent sphere of the default cartridge, as text: glass volume (mm^3), mass (g),
+    centre of mass (mm), inertia (kg m^2), sphere diameter (mm), Reissner stiffness (N/m),
+    Hertz contact time at ``v_rel`` (m/s) and the Rayleigh time step (s)."""
+    cart = Cartridge()
+    sphere = cart.equivalent_sphere()
+    body = ContactBody.from_cartridge(cart)
+    mp = cart.mass_properties()
+    m = cart.material
+    return "\n".join([
+        f"Default cartridge (3 mL, ISO 13926-1 style), glass: {m.name}",
+        f"  glass volume        {cart.glass_volume * 1e9:10.1f} mm^3",
+        f"  mass                {cart.mass * 1e3:10.3f} g",
+        f"  centre of mass z    {mp.center_of_mass[2] * 1e3:10.2f} mm from the open end",
+        f"  inertia (Ixx, Izz)  {mp.inertia[0, 0]:10.3e} {mp.inertia[2, 2]:10.3e} kg m^2",
+        f"  equivalent sphere   {sphere.diameter * 1e3:10.2f} mm diameter",
+        f"  Reissner k_R        {body.k_reissner:10.3e} N/m (t = {cart.wall_thickness * 1e3:g} mm,"
+        f" R = {cart.body_mid_radius * 1e3:g} mm)",
+        f"  Hertz contact time  {hertz_contact_duration(body, body, v_rel) * 1e6:10.2f} us"
+        f" at {v_rel:g} m/s",
+        f"  Rayleigh time step  "
+        f"{rayleigh_time_step(sphere.radius, m.E, m.nu, m.density) * 1e6:10.3f} us",
+    ])
 
 
 def write_calibration(out_dir: "str | Path", table: CalibrationTable) -> tuple[Path, Path]:

@@ -14,9 +14,8 @@ __all__ = ["main", "build_parser", "study_options_from_args"]
 
 
 def _cmd_calibrate(args: argparse.Namespace) -> int:
-    from demfem.calibration import force_vs_modulus, write_calibration
+    from demfem.calibration import calibration_report, force_vs_modulus, write_calibration
     from demfem.cartridge import Cartridge
-    from demfem.pipeline import calibration_report
 
     print(calibration_report(args.v_rel))
     E = np.logspace(np.log10(args.e_min), np.log10(args.e_max), args.n)

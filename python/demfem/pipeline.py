@@ -32,51 +32,13 @@ from typing import Any, Callable, Optional
 
 import numpy as np
 
-from demfem.errors import InvalidParameterError, SimulationInterrupted, check_positive
+from demfem.errors import SimulationInterrupted, check_positive, check_range
 
-__all__ = ["calibration_report", "run_pipeline", "NOT_YET"]
+__all__ = ["run_pipeline", "NOT_YET"]
 
 #: The paper's stages demfem does not run yet (printed by the report, kept in the summary).
 NOT_YET = ("FEM of the seven-cartridge cluster (stage 4)",
            "breakage probability per cartridge from the DEM collisions (stage 5)")
-
-
-def calibration_report(v_rel: float = 0.2) -> str:
-    """The equivalent sphere of the default cartridge, as text: glass volume (mm^3), mass (g),
-    centre of mass (mm), inertia (kg m^2), sphere diameter (mm), Reissner stiffness (N/m),
-    Hertz contact time at ``v_rel`` (m/s) and the Rayleigh time step (s)."""
-    from demfem.cartridge import Cartridge
-    from demfem.contact import ContactBody, hertz_contact_duration, rayleigh_time_step
-
-    cart = Cartridge()
-    sphere = cart.equivalent_sphere()
-    body = ContactBody.from_cartridge(cart)
-    mp = cart.mass_properties()
-    m = cart.material
-    return "\n".join([
-        f"Default cartridge (3 mL, ISO 13926-1 style), glass: {m.name}",
-        f"  glass volume        {cart.glass_volume * 1e9:10.1f} mm^3",
-        f"  mass                {cart.mass * 1e3:10.3f} g",
-        f"  centre of mass z    {mp.center_of_mass[2] * 1e3:10.2f} mm from the open end",
-        f"  inertia (Ixx, Izz)  {mp.inertia[0, 0]:10.3e} {mp.inertia[2, 2]:10.3e} kg m^2",
-        f"  equivalent sphere   {sphere.diameter * 1e3:10.2f} mm diameter",
-        f"  Reissner k_R        {body.k_reissner:10.3e} N/m (t = {cart.wall_thickness * 1e3:g} mm,"
-        f" R = {cart.body_mid_radius * 1e3:g} mm)",
-        f"  Hertz contact time  {hertz_contact_duration(body, body, v_rel) * 1e6:10.2f} us"
-        f" at {v_rel:g} m/s",
-        f"  Rayleigh time step  "
-        f"{rayleigh_time_step(sphere.radius, m.E, m.nu, m.density) * 1e6:10.3f} us",
-    ])
-
-
-def _check(name: str, value: float, lo: float, hi: float = math.inf) -> float:
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise InvalidParameterError(f"invalid {name} = {value!r}: must be a number") from None
-    if not (math.isfinite(x) and lo < x <= hi):
-        raise InvalidParameterError(f"invalid {name} = {value!r}: must be in ({lo:g}, {hi:g}]")
-    return x
 
 
 def run_pipeline(out: str | Path = "demfem_out/run", duration: float = 1.0,
@@ -108,19 +70,20 @@ def run_pipeline(out: str | Path = "demfem_out/run", duration: float = 1.0,
     """
     from demfem.analysis.collisions import onset_histogram, onset_quantiles
     from demfem.analysis.kinematics import tagged_speed
-    from demfem.calibration import force_vs_modulus, write_calibration
+    from demfem.calibration import calibration_report, force_vs_modulus, write_calibration
     from demfem.cartridge import Cartridge
     from demfem.io.atomic import savefig_atomic, write_text_atomic
     from demfem.plots import plot_table_snapshot
+    from demfem.progress import ProgressBar
     from demfem.scenes.table import AccumulationTable, Tag
     from demfem.studies.figures import _write_vtk_series
-    from demfem.studies.table_run import _check_run_arguments, run_table
+    from demfem.studies.table_run import _check_run_arguments, _checkpoint_files, run_table
 
     # every argument checked before any work
     _check_run_arguments(duration, sample_interval, threads)
     v_rel = check_positive("v_rel", v_rel)
-    discard = 0.5 * duration if discard_before is None else _check(
-        "discard_before", discard_before, -math.inf, duration)
+    discard = 0.5 * duration if discard_before is None else check_range(
+        "discard_before", discard_before, hi=duration, hi_open=False)
     table = AccumulationTable() if young_modulus is None else AccumulationTable(
         young_modulus=young_modulus)
     out = Path(out)
@@ -137,28 +100,26 @@ def run_pipeline(out: str | Path = "demfem_out/run", duration: float = 1.0,
     # 2. DEM of the table
     log(f"\n== 2. DEM: the accumulation table, {table.n_spheres} spheres, "
         f"E = {table.young_modulus:.3g} Pa, {duration:g} s ==")
-    from demfem.progress import ProgressBar
-
     bar = ProgressBar(duration, label="table") if progress is True else None
     callback = bar if bar is not None else (progress if callable(progress) else None)
+    checkpoint = out / "table.ck"
     try:
-        run = run_table(table, duration, sample_interval, threads=threads, progress=callback,
-                        checkpoint=out / "table.ck", checkpoint_every=checkpoint_every)
+        try:
+            run = run_table(table, duration, sample_interval, threads=threads,
+                            progress=callback, checkpoint=checkpoint,
+                            checkpoint_every=checkpoint_every)
+        finally:
+            if bar is not None:
+                bar.close()
     except SimulationInterrupted:
-        if bar is not None:
-            bar.close()
-            bar = None
-        saved = out / "table.ck.json"
+        saved = _checkpoint_files(checkpoint)[2]  # its wall and simulated time
         if saved.exists() and "sim_time_s" in (state := json.loads(saved.read_text())):
             log(f"interrupted: started again with the same arguments, the job resumes from "
-                f"its checkpoint at t = {state['sim_time_s']:.4g} s ({out / 'table.ck'})")
+                f"its checkpoint at t = {state['sim_time_s']:.4g} s ({checkpoint})")
         else:
             log(f"interrupted before the first checkpoint (every {checkpoint_every:g} s of "
                 "wall time): nothing to resume")
         raise
-    finally:
-        if bar is not None:
-            bar.close()
     run_path = run.save(out / "table_run.npz")
     info = run.info
     log(f"  {info['steps']} steps of {info['dt']:.3g} s in {info['wall_time_s']:.1f} s wall "
