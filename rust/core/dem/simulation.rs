@@ -368,11 +368,12 @@ pub struct Simulation {
     pub(crate) needs_rebuild: bool,
     // ---- derived, rebuilt from the state
     /// Gather lists of the pairs in contact: `active_entry[active_base[i]..][..active_len[i]]`
-    /// holds, in increasing order, 2e + 1 for each active pair e in which particle i is the
-    /// first particle and 2e where it is the second. The room of particle i is the number of
-    /// its candidate pairs, so the list never overflows; it is kept in step with
-    /// `pair_active` by [`Simulation::sync_active_lists`] after each force phase, from the
-    /// few contacts that began or ended.
+    /// holds, in increasing order, 2e for each active pair e in which particle i is the
+    /// first particle and 2e + 1 where it is the second (the low bit is the sign bit of the
+    /// pair force on it). The room of particle i is the number of its candidate pairs, so
+    /// the list never overflows; it is kept in step with `pair_active` by
+    /// [`Simulation::sync_active_lists`] after each force phase, from the few contacts that
+    /// began or ended.
     active_base: Vec<u32>,
     active_len: Vec<u32>,
     active_entry: Vec<u32>,
@@ -1354,7 +1355,6 @@ impl Gather<'_> {
         let planar = on::<E>(c.effects, Effect::Planar);
         let mut f = Sum3::zero();
         let mut t = Sum3::zero();
-        let mut z = 0u32;
         // the pairs in contact in increasing index order (those where the particle is j
         // first, as their i is smaller); the force on i is +force, on j −force: added times
         // ±1, which is exactly the subtraction
@@ -1363,17 +1363,20 @@ impl Gather<'_> {
             .active_entry
             .get(start..start + active_len[k] as usize)
             .unwrap_or(&[]);
+        // every entry names a pair of `pair_out` (the lists are made from the pair list)
+        let z = listed.len() as u32;
+        let r = radius[k];
         for &a in listed {
             let e = (a >> 1) as usize;
             let Some(p) = pair_out.get(e) else {
                 continue;
             };
-            // + for the first particle (a odd), − for the second: the sign bit flipped
-            let flip = u64::from(!a & 1) << 63;
-            z += 1;
+            // + for the first particle (a even), − for the second (a odd): the sign bit
+            // flipped
+            let flip = u64::from(a) << 63;
             f.add_flipped(flip, p.force);
             if rotation {
-                let arm = radius[k] - 0.5 * p.overlap;
+                let arm = r - 0.5 * p.overlap;
                 t.add_scaled(arm, p.torque_per_arm);
                 if rolling {
                     t.add_flipped(flip, pair_rolling[e]);
@@ -1386,8 +1389,10 @@ impl Gather<'_> {
         }
         let mut zw = 0u32;
         let mut onsets = 0u32;
-        let own_slots = k * stride..(k + 1) * stride;
-        for (s, o) in slots[own_slots.clone()].iter().zip(&wall_out[own_slots]) {
+        let row = k * stride;
+        let (own, out) = (&slots[row..row + stride], &wall_out[row..row + stride]);
+        for q in 0..stride {
+            let (s, o) = (&own[q], &out[q]);
             if s.wall == NO_WALL {
                 break;
             }
@@ -1810,7 +1815,7 @@ impl Simulation {
         self.active_len.resize(n, 0);
         for (e, (p, &on)) in self.pairs.iter().zip(&self.pair_active).enumerate() {
             if on {
-                for (k, side) in [(p.i as usize, 1), (p.j as usize, 0)] {
+                for (k, side) in [(p.i as usize, 0), (p.j as usize, 1)] {
                     let at = (self.active_base[k] + self.active_len[k]) as usize;
                     self.active_entry[at] = 2 * e as u32 + side;
                     self.active_len[k] += 1;
@@ -1850,7 +1855,7 @@ impl Simulation {
                 }
                 self.pair_listed[e] = on;
                 let p = &self.pairs[e];
-                for (k, side) in [(p.i as usize, 1), (p.j as usize, 0)] {
+                for (k, side) in [(p.i as usize, 0), (p.j as usize, 1)] {
                     let entry = 2 * e as u32 + side;
                     let base = self.active_base[k] as usize;
                     let len = self.active_len[k] as usize;
