@@ -452,10 +452,13 @@ struct PairCtx<'a> {
     /// Every pair follows the Hertz law ([`LawKind::Hertz`]), so with AVX2 the batched pair
     /// kernel copies the constants without testing the law of each.
     pairs_hertz: bool,
-    /// Every pair indexes the same Hertz entry of `table` and every particle has the same
-    /// radius (m): (entry, radius). The batched pair kernel then writes the constants and
-    /// radii into its batch once per call instead of once per contact.
+    /// Every pair indexes the same Hertz or Hertz–Reissner entry of `table` and every
+    /// particle has the same radius (m): (entry, radius). The batched pair kernel then writes
+    /// the constants and radii into its batch once per call instead of once per contact,
+    /// and with AVX2 evaluates the law in its lanes.
     pairs_uniform: Option<(u32, f64)>,
+    /// The entry of `pairs_uniform` is a Hertz–Reissner law.
+    pairs_uniform_reissner: bool,
     /// The travel bound of this force evaluation, m (see [`Simulation::travel`]).
     travel: f64,
     /// A pair is skipped only if half its gap exceeds this, m: `SKIP_STEPS` times the
@@ -587,9 +590,13 @@ struct ForcePart<'a> {
 #[derive(Debug, Default)]
 struct WallLists {
     /// Groups of the AVX2 plane pass: (first particle relative to the block's first, slot
-    /// column); the four particles from there hold the same plane with Hertz constants in
-    /// that column and are alive.
+    /// column); the four particles from there hold the same plane in that column, with the
+    /// constants of a Hertz law, or with those of a Hertz–Reissner law where
+    /// `plane_reissner`, and are alive.
     planes: Vec<(u32, u32)>,
+    /// Every group's law is Hertz–Reissner (else every group's is Hertz): the law of the
+    /// first group taken, which the others must share.
+    plane_reissner: bool,
     /// Every other slot holding a wall, of alive particles: (particle, slot), both relative
     /// to the block's first.
     rest: Vec<(u32, u32)>,
@@ -611,6 +618,8 @@ struct BlockWalls<'a> {
     rest: &'a [(u32, u32)],
     /// [`WallLists::plane_const`].
     plane_const: Option<u32>,
+    /// [`WallLists::plane_reissner`].
+    plane_reissner: bool,
 }
 
 /// Runs `run` on every part, the first on the calling thread, the others offered to the
@@ -1952,8 +1961,10 @@ impl Simulation {
         let r0 = self.radius.first().copied();
         self.pairs_uniform = match (first_k, r0) {
             (Some(k0), Some(r0))
-                if self.pairs_hertz
-                    && self.pair_const.iter().all(|&k| k == k0)
+                if matches!(
+                    table.get(k0 as usize).map(|c| c.kind),
+                    Some(LawKind::Hertz | LawKind::HertzReissner)
+                ) && self.pair_const.iter().all(|&k| k == k0)
                     && self.radius.iter().all(|&r| r.to_bits() == r0.to_bits()) =>
             {
                 Some((k0, r0))
@@ -1980,6 +1991,8 @@ impl Simulation {
         lists.mode = Some((parallel, self.avx2, self.batched));
         // Some(None) until a group is taken, then Some(Some(k)) while all share entry k
         let mut plane_const: Option<Option<u32>> = Some(None);
+        // the law of the groups: that of the first group taken
+        let mut plane_kind: Option<LawKind> = None;
         let mut ends = vec![0];
         if parallel {
             ends.extend(&self.cut_lists.particle);
@@ -2006,14 +2019,16 @@ impl Simulation {
                             walls.get(w as usize).map(|w| &w.shape),
                             Some(WallShape::Plane { .. })
                         );
+                        let kind = table[slot(0).k as usize].kind;
                         let take = plane
+                            && matches!(kind, LawKind::Hertz | LawKind::HertzReissner)
+                            && plane_kind.is_none_or(|k| k == kind)
                             && (0..4).all(|l| {
                                 let s = slot(l);
-                                s.wall == w
-                                    && alive[g + l]
-                                    && table[s.k as usize].kind == LawKind::Hertz
+                                s.wall == w && alive[g + l] && table[s.k as usize].kind == kind
                             });
                         if take {
+                            plane_kind = Some(kind);
                             lists.planes.push(((g - first) as u32, q as u32));
                             for l in 0..4 {
                                 let s = &mut slots[(g + l) * stride + q];
@@ -2045,6 +2060,7 @@ impl Simulation {
             lists.cuts.push((lists.planes.len(), lists.rest.len()));
         }
         lists.plane_const = plane_const.flatten();
+        lists.plane_reissner = plane_kind == Some(LawKind::HertzReissner);
     }
 
     /// Rebuild the Verlet lists (pairs, wall slots, gather lists), carrying contact history over.
@@ -2232,6 +2248,10 @@ impl Simulation {
                 batched: self.batched,
                 pairs_hertz: self.pairs_hertz,
                 pairs_uniform: self.pairs_uniform,
+                pairs_uniform_reissner: self.pairs_uniform.is_some_and(|(k, _)| {
+                    self.contact_table.get(k as usize).map(|c| c.kind)
+                        == Some(LawKind::HertzReissner)
+                }),
                 travel: self.travel,
                 min_skip: SKIP_STEPS * self.travel_step,
             };
@@ -2272,11 +2292,13 @@ impl Simulation {
                         planes: &wall_lists.planes[a.0..b.0],
                         rest: &wall_lists.rest[a.1..b.1],
                         plane_const: wall_lists.plane_const,
+                        plane_reissner: wall_lists.plane_reissner,
                     },
                     _ => BlockWalls {
                         planes: &[],
                         rest: &[],
                         plane_const: None,
+                        plane_reissner: false,
                     },
                 };
                 BATCH_SCRATCH.with_borrow_mut(|b| {
@@ -2672,7 +2694,7 @@ impl Simulation {
     }
 
     /// Whether the batched AVX2 pair kernel takes the uniform path: every pair indexes one
-    /// Hertz law entry and every sphere has one radius, so the constants and radii are
+    /// Hertz or Hertz–Reissner law entry and every sphere has one radius, so the constants and radii are
     /// written into the batch once per chunk (a diagnostic; results are bitwise those of the
     /// general path).
     pub fn uniform_pairs(&self) -> bool {

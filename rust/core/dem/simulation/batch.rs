@@ -81,6 +81,9 @@ pub(super) struct Batch {
     mu: [f64; BATCH],
     /// All bits set where `f_el`, `c_n`, `k_t` hold Hertz constants, not law values.
     hertz: [u64; BATCH],
+    /// (k_H/k_R)², 1/m, of a Hertz–Reissner contact ([`ContactConst`]), for the AVX2 force
+    /// pass that evaluates that law in its lanes.
+    s_scale: [f64; BATCH],
     // ---- results
     /// Force on the particle (pair: i), N.
     force: Lanes3,
@@ -116,6 +119,7 @@ impl Batch {
         ct_ratio: [0.0; BATCH],
         mu: [0.0; BATCH],
         hertz: [0; BATCH],
+        s_scale: [0.0; BATCH],
         force: Lanes3::ZERO,
         torque_per_arm: Lanes3::ZERO,
         f_n: [0.0; BATCH],
@@ -141,6 +145,7 @@ impl Batch {
         self.k_t[k] = konst.k_t;
         self.ct_ratio[k] = konst.ct_ratio;
         self.mu[k] = konst.mu;
+        self.s_scale[k] = konst.s_scale;
     }
 
     /// Every lane's Hertz constants set to `konst` (see [`WallLists::plane_const`]).
@@ -240,9 +245,9 @@ fn contact_forces<const E: u16>(b: &mut Batch, c: &PairCtx<'_>, all_hertz: bool)
         // SAFETY: `avx2` is set only when the CPU reported AVX2.
         unsafe {
             if all_hertz {
-                avx2_forces::contact_forces::<E, true>(b, c)
+                avx2_forces::contact_forces::<E, true, false>(b, c)
             } else {
-                avx2_forces::contact_forces::<E, false>(b, c)
+                avx2_forces::contact_forces::<E, false, false>(b, c)
             }
         };
         return;
@@ -655,6 +660,24 @@ mod avx2_forces {
         detail: &mut [WallDetail],
         b: &mut Batch,
     ) {
+        if lists.plane_reissner {
+            plane_slots_law::<E, true>(c, first, lists, slots, out, detail, b)
+        } else {
+            plane_slots_law::<E, false>(c, first, lists, slots, out, detail, b)
+        }
+    }
+
+    /// [`plane_slots`] for groups of Hertz (`R` false) or Hertz–Reissner (`R`) contacts.
+    #[inline(always)]
+    unsafe fn plane_slots_law<const E: u16, const R: bool>(
+        c: &WallCtx<'_>,
+        first: usize,
+        lists: BlockWalls<'_>,
+        slots: &mut [WallContact],
+        out: &mut [WallOut],
+        detail: &mut [WallDetail],
+        b: &mut Batch,
+    ) {
         let stride = c.wall_stride;
         let n_slots = slots.len();
         let n_part = n_slots / stride;
@@ -742,7 +765,7 @@ mod avx2_forces {
                 // four contacts that go on, the common case: forces and scatter (that of
                 // `plane_scatter`) from the lanes, without the batch; the lanes k..k + 4
                 // are not claimed, so the next group reuses them
-                let f = forces4::<E, true>(b, &c.shared, k, pl.n, v_rel, spin, overlap, history);
+                let f = forces4::<E, true, R>(b, &c.shared, k, pl.n, v_rel, spin, overlap, history);
                 plane_out_rows(out, g, q, stride, f.force, scale(arm, f.torque_per_arm));
                 plane_spring_rows(slots, g, q, stride, f.history);
                 continue;
@@ -759,13 +782,13 @@ mod avx2_forces {
             n_groups += 1;
             b.len = 4 * n_groups;
             if n_groups == BATCH / 4 {
-                plane_scatter::<E>(c, first, &groups[..n_groups], slots, out, detail, b);
+                plane_scatter::<E, R>(c, first, &groups[..n_groups], slots, out, detail, b);
                 n_groups = 0;
                 b.len = 0;
             }
         }
         if n_groups > 0 {
-            plane_scatter::<E>(c, first, &groups[..n_groups], slots, out, detail, b);
+            plane_scatter::<E, R>(c, first, &groups[..n_groups], slots, out, detail, b);
         }
         b.len = 0;
     }
@@ -826,6 +849,11 @@ mod avx2_forces {
             k,
             _mm256_setr_pd(kp(0).mu, kp(1).mu, kp(2).mu, kp(3).mu),
         );
+        st(
+            &mut b.s_scale,
+            k,
+            _mm256_setr_pd(kp(0).s_scale, kp(1).s_scale, kp(2).s_scale, kp(3).s_scale),
+        );
         _mm256_storeu_si256(
             b.hertz.as_mut_ptr().add(k) as *mut __m256i,
             _mm256_castpd_si256(all),
@@ -835,7 +863,7 @@ mod avx2_forces {
     /// Forces of the groups of [`plane_slots`] in the batch, and their scatter (that of
     /// [`wall_chunk_batched`]).
     #[inline(always)]
-    unsafe fn plane_scatter<const E: u16>(
+    unsafe fn plane_scatter<const E: u16, const R: bool>(
         c: &WallCtx<'_>,
         first: usize,
         groups: &[(u32, u32, u32)],
@@ -844,8 +872,8 @@ mod avx2_forces {
         detail: &mut [WallDetail],
         b: &mut Batch,
     ) {
-        // every lane of a plane group holds Hertz constants
-        contact_forces::<E, true>(b, &c.shared);
+        // every lane of a plane group holds the constants of the groups' law
+        contact_forces::<E, true, R>(b, &c.shared);
         let stride = c.wall_stride;
         let moving = on::<E>(c.shared.effects, Effect::MovingWalls);
         for (gi, &(g, q, m)) in groups.iter().enumerate() {
@@ -939,7 +967,7 @@ mod avx2_forces {
     /// batch. The other groups' results go to the batch for the lane-by-lane scatter;
     /// returns a bit per such group (group g: lanes 4g..4g + 4).
     #[target_feature(enable = "avx2")]
-    pub(super) unsafe fn uniform_pairs<const E: u16>(
+    pub(super) unsafe fn uniform_pairs<const E: u16, const R: bool>(
         b: &mut Batch,
         c: &PairCtx<'_>,
         chunk: &mut [PairContact],
@@ -953,7 +981,7 @@ mod avx2_forces {
         while k < len {
             let (n, overlap, spin) = geometry4::<E>(b, c, k);
             let (v_rel, history) = (load(&b.v_rel, k), load(&b.history, k));
-            let f = forces4::<E, true>(b, c, k, n, v_rel, spin, overlap, history);
+            let f = forces4::<E, true, R>(b, c, k, n, v_rel, spin, overlap, history);
             let going_on = |l: usize| active.get(b.index[k + l] as usize) == Some(&true);
             if !c.detail && k + 4 <= len && going_on(0) && going_on(1) && going_on(2) && going_on(3)
             {
@@ -1023,6 +1051,192 @@ mod avx2_forces {
         }
     }
 
+    /// ⌊x / 3⌋ of four u64 lanes below 2⁶³ (AVX2 has no 64-bit division or high multiply):
+    /// x = h 2³² + l, ⌊x/3⌋ = ⌊h/3⌋ 2³² + r_h ⌊2³²/3⌋ + ⌊l/3⌋ + ⌊(r_h + r_l)/3⌋, with r_h, r_l
+    /// the remainders (2³² = 3 ⌊2³²/3⌋ + 1) and ⌊a/3⌋ = (a · 0xAAAAAAAB) >> 33 for a < 2³².
+    #[inline(always)]
+    unsafe fn div3_u64(x: __m256i) -> __m256i {
+        let magic = _mm256_set1_epi64x(0xAAAA_AAAB);
+        let div3_32 = |a: __m256i| _mm256_srli_epi64::<33>(_mm256_mul_epu32(a, magic));
+        let times3 = |a: __m256i| _mm256_add_epi64(_mm256_slli_epi64::<1>(a), a);
+        let hi = _mm256_srli_epi64::<32>(x);
+        let lo = _mm256_and_si256(x, _mm256_set1_epi64x(0xFFFF_FFFF));
+        let (q_hi, q_lo) = (div3_32(hi), div3_32(lo));
+        let r_hi = _mm256_sub_epi64(hi, times3(q_hi));
+        let r_lo = _mm256_sub_epi64(lo, times3(q_lo));
+        // r_h + r_l ≤ 4: its third is 1 from 3 up
+        let carry = _mm256_srli_epi64::<63>(_mm256_cmpgt_epi64(
+            _mm256_add_epi64(r_hi, r_lo),
+            _mm256_set1_epi64x(2),
+        ));
+        let low = _mm256_add_epi64(
+            _mm256_add_epi64(
+                _mm256_mul_epu32(r_hi, _mm256_set1_epi64x(0x5555_5555)),
+                q_lo,
+            ),
+            carry,
+        );
+        _mm256_add_epi64(_mm256_slli_epi64::<32>(q_hi), low)
+    }
+
+    /// [`contact::hertz_reissner_root`] of four lanes, its operations in its order (bitwise
+    /// its results); a lane whose s is 1e45 or more (the asymptote's branch, never met by
+    /// physical overlaps) is solved by the scalar function.
+    #[inline(always)]
+    unsafe fn hertz_reissner_root4(s: __m256d) -> __m256d {
+        let zero = _mm256_setzero_pd();
+        let r2 = _mm256_sqrt_pd(s);
+        let bits = _mm256_castpd_si256(s);
+        let r3 = _mm256_castsi256_pd(_mm256_add_epi64(
+            div3_u64(bits),
+            _mm256_set1_epi64x(0x2A9F_7893_782D_A1CE),
+        ));
+        // r2.min((r3 − 1/3).max(0.75 r3)) (all finite and > 0 here, where min and max
+        // agree with f64's), or r2 for s ≤ 0.17
+        let far = _mm256_min_pd(
+            r2,
+            _mm256_max_pd(
+                _mm256_sub_pd(r3, _mm256_set1_pd(1.0 / 3.0)),
+                _mm256_mul_pd(_mm256_set1_pd(0.75), r3),
+            ),
+        );
+        let small = _mm256_cmp_pd::<_CMP_LE_OQ>(s, _mm256_set1_pd(0.17));
+        let m = _mm256_blendv_pd(far, r2, small);
+        let one = _mm256_set1_pd(1.0);
+        let mut u = _mm256_sqrt_pd(_mm256_div_pd(s, _mm256_add_pd(one, m)));
+        for _ in 0..2 {
+            let g = _mm256_sub_pd(_mm256_mul_pd(_mm256_mul_pd(u, u), _mm256_add_pd(u, one)), s);
+            let d1 = _mm256_mul_pd(
+                u,
+                _mm256_add_pd(_mm256_mul_pd(_mm256_set1_pd(3.0), u), _mm256_set1_pd(2.0)),
+            );
+            let d2 = _mm256_add_pd(_mm256_mul_pd(_mm256_set1_pd(6.0), u), _mm256_set1_pd(2.0));
+            let den = _mm256_sub_pd(
+                _mm256_mul_pd(d1, d1),
+                _mm256_mul_pd(_mm256_mul_pd(_mm256_set1_pd(0.5), g), d2),
+            );
+            u = _mm256_sub_pd(u, _mm256_div_pd(_mm256_mul_pd(g, d1), den));
+        }
+        // !(s > 0) (NaN included) → 0
+        let positive = _mm256_cmp_pd::<_CMP_GT_OQ>(s, zero);
+        u = _mm256_and_pd(u, positive);
+        let huge = _mm256_cmp_pd::<_CMP_GE_OQ>(s, _mm256_set1_pd(1e45));
+        if _mm256_movemask_pd(huge) != 0 {
+            let (mut sl, mut ul) = ([0.0; 4], [0.0; 4]);
+            _mm256_storeu_pd(sl.as_mut_ptr(), s);
+            _mm256_storeu_pd(ul.as_mut_ptr(), u);
+            for (u, &s) in ul.iter_mut().zip(&sl) {
+                if s >= 1e45 {
+                    *u = contact::hertz_reissner_root(s);
+                }
+            }
+            u = _mm256_loadu_pd(ul.as_ptr());
+        }
+        u
+    }
+
+    #[cfg(test)]
+    mod tests {
+        use super::*;
+
+        #[target_feature(enable = "avx2")]
+        unsafe fn root_lanes(s: [f64; 4]) -> [f64; 4] {
+            let mut u = [0.0; 4];
+            _mm256_storeu_pd(
+                u.as_mut_ptr(),
+                hertz_reissner_root4(_mm256_loadu_pd(s.as_ptr())),
+            );
+            u
+        }
+
+        #[target_feature(enable = "avx2")]
+        unsafe fn div3_lanes(x: [u64; 4]) -> [u64; 4] {
+            let mut q = [0u64; 4];
+            let v = div3_u64(_mm256_loadu_si256(x.as_ptr() as *const __m256i));
+            _mm256_storeu_si256(q.as_mut_ptr() as *mut __m256i, v);
+            q
+        }
+
+        /// xorshift64*: reproducible test values without a dependency.
+        fn next(state: &mut u64) -> u64 {
+            *state ^= *state >> 12;
+            *state ^= *state << 25;
+            *state ^= *state >> 27;
+            state.wrapping_mul(0x2545_F491_4F6C_DD1D)
+        }
+
+        #[test]
+        fn lane_root_and_division_by_three_are_bitwise_the_scalar_ones() {
+            if !is_x86_feature_detected!("avx2") {
+                return;
+            }
+            let mut state = 0x9E37_79B9_7F4A_7C15u64;
+            // ⌊x/3⌋ for x < 2⁶³: random bits, and the ends of every 32-bit half
+            let mut xs: Vec<u64> = (0..40_000).map(|_| next(&mut state) >> 1).collect();
+            for hi in [0u64, 1, 2, 3, 0x7FFF_FFFF, 0x7FFF_FFFE] {
+                for lo in [
+                    0u64,
+                    1,
+                    2,
+                    3,
+                    4,
+                    0xFFFF_FFFC,
+                    0xFFFF_FFFD,
+                    0xFFFF_FFFE,
+                    0xFFFF_FFFF,
+                ] {
+                    xs.push(hi << 32 | lo);
+                }
+            }
+            for x in xs.chunks_exact(4) {
+                let x = [x[0], x[1], x[2], x[3]];
+                // SAFETY: the CPU has AVX2 (tested above).
+                let q = unsafe { div3_lanes(x) };
+                for l in 0..4 {
+                    assert_eq!(q[l], x[l] / 3, "x = {:#x}", x[l]);
+                }
+            }
+            // the root: the branches' borders, the special values, log-uniform s over
+            // 1e-300 … 1e60, and random positive doubles
+            let mut ss = vec![
+                0.0,
+                -0.0,
+                -1.0,
+                f64::NAN,
+                f64::INFINITY,
+                f64::MIN_POSITIVE,
+                5e-324,
+                0.17,
+                0.1700000000000001,
+                0.16999999999999998,
+                1.0,
+                1e45,
+                9.999999999999999e44,
+                1e300,
+                f64::MAX,
+            ];
+            for _ in 0..40_000 {
+                let t = (next(&mut state) >> 11) as f64 / (1u64 << 53) as f64;
+                ss.push(10f64.powf(-300.0 + 360.0 * t));
+            }
+            for _ in 0..4000 {
+                ss.push(f64::from_bits(next(&mut state) >> 1));
+            }
+            while ss.len() % 4 != 0 {
+                ss.push(1.0);
+            }
+            for s in ss.chunks_exact(4) {
+                let s = [s[0], s[1], s[2], s[3]];
+                // SAFETY: the CPU has AVX2 (tested above).
+                let u = unsafe { root_lanes(s) };
+                for l in 0..4 {
+                    let want = contact::hertz_reissner_root(s[l]);
+                    assert_eq!(u[l].to_bits(), want.to_bits(), "s = {:e}", s[l]);
+                }
+            }
+        }
+    }
+
     /// What [`forces4`] gives for four contacts: force on the particle (pair: i), N;
     /// n × f_t, N; the new spring ξ, m; the normal force, N.
     #[derive(Clone, Copy)]
@@ -1038,7 +1252,7 @@ mod avx2_forces {
     /// batch.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    unsafe fn forces4<const E: u16, const H: bool>(
+    unsafe fn forces4<const E: u16, const H: bool, const R: bool>(
         b: &Batch,
         c: &PairCtx<'_>,
         k: usize,
@@ -1058,18 +1272,35 @@ mod avx2_forces {
         }
         let v_n = dot(v_rel, n);
         let v_t = sub(v_rel, scale(v_n, n));
-        // the Hertz law where the lanes hold its constants (`law_at`'s operations; with
-        // `H`, every lane does)
-        let sq = _mm256_sqrt_pd(overlap);
         let (f_el, c_n, k_t) = (ld(&b.f_el, k), ld(&b.c_n, k), ld(&b.k_t, k));
-        let hertz_f_el = _mm256_mul_pd(_mm256_mul_pd(f_el, sq), overlap);
-        let hertz_c_n = if damping {
-            _mm256_mul_pd(c_n, _mm256_sqrt_pd(sq))
+        let (hertz_f_el, hertz_c_n, hertz_k_t) = if R {
+            // every lane follows the Hertz–Reissner law (`law_at`'s operations)
+            let u = hertz_reissner_root4(_mm256_mul_pd(ld(&b.s_scale, k), overlap));
+            let c_n = if damping {
+                let w = _mm256_mul_pd(_mm256_set1_pd(3.0), u);
+                let q = _mm256_div_pd(w, _mm256_add_pd(_mm256_set1_pd(2.0), w));
+                _mm256_mul_pd(c_n, _mm256_sqrt_pd(q))
+            } else {
+                zero
+            };
+            let u3 = _mm256_mul_pd(_mm256_mul_pd(u, u), u);
+            (_mm256_mul_pd(f_el, u3), c_n, _mm256_mul_pd(k_t, u))
         } else {
-            zero
+            // the Hertz law where the lanes hold its constants (`law_at`'s operations; with
+            // `H`, every lane does)
+            let sq = _mm256_sqrt_pd(overlap);
+            let c_n = if damping {
+                _mm256_mul_pd(c_n, _mm256_sqrt_pd(sq))
+            } else {
+                zero
+            };
+            (
+                _mm256_mul_pd(_mm256_mul_pd(f_el, sq), overlap),
+                c_n,
+                _mm256_mul_pd(k_t, sq),
+            )
         };
-        let hertz_k_t = _mm256_mul_pd(k_t, sq);
-        let (f_el, c_n, k_t) = if H {
+        let (f_el, c_n, k_t) = if H || R {
             (hertz_f_el, hertz_c_n, hertz_k_t)
         } else {
             let hertz =
@@ -1147,7 +1378,7 @@ mod avx2_forces {
     }
 
     #[target_feature(enable = "avx2")]
-    pub(super) unsafe fn contact_forces<const E: u16, const H: bool>(
+    pub(super) unsafe fn contact_forces<const E: u16, const H: bool, const R: bool>(
         b: &mut Batch,
         c: &PairCtx<'_>,
     ) {
@@ -1160,7 +1391,7 @@ mod avx2_forces {
             } else {
                 load(&b.n, k)
             };
-            let f = forces4::<E, H>(
+            let f = forces4::<E, H, R>(
                 b,
                 c,
                 k,
@@ -1305,7 +1536,13 @@ pub(super) fn pair_chunk_batched<const E: u16, const U: bool>(
         if U {
             // SAFETY: `U` is set only with `avx2`, which is set only when the CPU reported
             // AVX2.
-            rest = unsafe { avx2_forces::uniform_pairs::<E>(b, c, chunk, active, out) };
+            rest = unsafe {
+                if c.pairs_uniform_reissner {
+                    avx2_forces::uniform_pairs::<E, true>(b, c, chunk, active, out)
+                } else {
+                    avx2_forces::uniform_pairs::<E, false>(b, c, chunk, active, out)
+                }
+            };
         }
         if !U {
             pair_geometry::<E>(b, c);
