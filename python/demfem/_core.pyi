@@ -166,6 +166,11 @@ class DemSimulation:
         """Active contacts: particle, partner, partner_is_wall, normal (K, 3), normal_force (N),
         tangential_force (K, 3) (N), overlap (m), point (K, 3) (m)."""
     def clear_records(self) -> None: ...
+    def set_phase_timing(self, on: bool) -> None:
+        """Start (True, from zero) or stop the per-thread clock of the step's two phases."""
+    def phase_times(self) -> list[tuple[float, float]]:
+        """(force phase s, particle phase s) of each engine thread's block since
+        set_phase_timing(True)."""
     def save_checkpoint(self, path: str | PathLike[str]) -> None: ...
     def load_checkpoint(self, path: str | PathLike[str]) -> None: ...
 

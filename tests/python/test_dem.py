@@ -71,6 +71,21 @@ def test_anchor_table_runs_and_reports_state():
     assert sim.riding_up_count() == 0
 
 
+def test_phase_clock_reads_each_threads_blocks_and_changes_nothing():
+    a = dem.DemSimulation.anchor_table(1e8, start="packed", threads=2)
+    b = dem.DemSimulation.anchor_table(1e8, start="packed", threads=2)
+    assert a.phase_times() == []
+    a.set_phase_timing(True)
+    a.step(500)
+    b.step(500)
+    times = a.phase_times()
+    # one (force, particle) pair per block of the two threads, each a positive duration
+    assert len(times) == 2
+    assert all(f > 0.0 and p > 0.0 for f, p in times)
+    a.set_phase_timing(False)
+    assert np.array_equal(a.positions(), b.positions())
+
+
 def test_outlet_plane_removes_particles():
     belt = dem.plane((0, 0, 0), (0, 0, 1), surface_velocity=(0.2, 0, 0))
     sim = dem.DemSimulation(np.array([[0.0, 0.0, R]]), np.array([R]), [GLASS], [belt], TABLE_EFFECTS,

@@ -695,6 +695,22 @@ impl DemSimulation {
         self.sim.clear_records();
     }
 
+    /// Start (`True`, from zero) or stop the per-thread clock of the two phases of a step
+    /// (diagnostics; off by default, and the results are the same either way).
+    fn set_phase_timing(&mut self, on: bool) {
+        self.sim.set_phase_timing(on);
+    }
+
+    /// Wall time of each engine thread's block in the force phase and in the particle
+    /// phase since `set_phase_timing(True)`, s: one `(force_s, particle_s)` per block.
+    fn phase_times(&self) -> Vec<(f64, f64)> {
+        self.sim
+            .phase_times()
+            .into_iter()
+            .map(|[force, particle]| (force, particle))
+            .collect()
+    }
+
     /// Write a checkpoint atomically to `path`.
     fn save_checkpoint(&self, py: Python<'_>, path: PathBuf) -> CoreResult<()> {
         let sim = &self.sim;
