@@ -11,7 +11,8 @@
 //! Run: `CARGO_TARGET_DIR=/work/target-dem cargo bench --bench dem_step`. Criterion reports
 //! time per iteration of `STEPS_PER_ITER` steps and the throughput in "elements" =
 //! particle-steps.
-use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use criterion::measurement::WallTime;
+use criterion::{criterion_group, criterion_main, BenchmarkGroup, Criterion, Throughput};
 use demfem::contact::reissner_stiffness;
 use demfem::dem::table::{anchor_scene, TableStart};
 use demfem::dem::{ContactModel, Effect, Scene, Simulation};
@@ -44,12 +45,24 @@ fn packed_scene() -> (Scene, Vec<u8>) {
     (scene, bytes)
 }
 
-fn bench_threads(c: &mut Criterion, bytes: &[u8]) {
-    let mut g = c.benchmark_group("anchor_table_packed_45GPa");
+/// A group of 10 samples of `STEPS_PER_ITER` steps of the 840 spheres, throughput in
+/// particle-steps, warmed up for `warm_up_ms` and measured for `measure_s`.
+fn group<'c>(
+    c: &'c mut Criterion,
+    name: &str,
+    warm_up_ms: u64,
+    measure_s: u64,
+) -> BenchmarkGroup<'c, WallTime> {
+    let mut g = c.benchmark_group(name);
     g.throughput(Throughput::Elements(840 * STEPS_PER_ITER));
     g.sample_size(10)
-        .warm_up_time(Duration::from_secs(1))
-        .measurement_time(Duration::from_secs(4));
+        .warm_up_time(Duration::from_millis(warm_up_ms))
+        .measurement_time(Duration::from_secs(measure_s));
+    g
+}
+
+fn bench_threads(c: &mut Criterion, bytes: &[u8]) {
+    let mut g = group(c, "anchor_table_packed_45GPa", 1000, 4);
     for (threads, avx2, batched) in [
         (1usize, true, true),
         (2, true, true),
@@ -86,11 +99,7 @@ fn bench_threads(c: &mut Criterion, bytes: &[u8]) {
 }
 
 fn bench_effects(c: &mut Criterion, scene: &Scene) {
-    let mut g = c.benchmark_group("effect_cost_1_thread");
-    g.throughput(Throughput::Elements(840 * STEPS_PER_ITER));
-    g.sample_size(10)
-        .warm_up_time(Duration::from_millis(500))
-        .measurement_time(Duration::from_secs(2));
+    let mut g = group(c, "effect_cost_1_thread", 500, 2);
     let variants: Vec<(&str, Box<dyn Fn(&mut Scene)>)> = vec![
         ("all_table_effects", Box::new(|_s: &mut Scene| {})),
         (
@@ -161,11 +170,7 @@ fn bench_effects(c: &mut Criterion, scene: &Scene) {
 /// kernels, which evaluate the law four contacts per instruction; `one_contact_at_a_time`:
 /// the reference kernels; `hertz_mindlin`: the same state without the shell, for scale.
 fn bench_series_law(c: &mut Criterion, scene: &Scene) {
-    let mut g = c.benchmark_group("series_law_packed_45GPa");
-    g.throughput(Throughput::Elements(840 * STEPS_PER_ITER));
-    g.sample_size(10)
-        .warm_up_time(Duration::from_secs(1))
-        .measurement_time(Duration::from_secs(4));
+    let mut g = group(c, "series_law_packed_45GPa", 1000, 4);
     for (name, series, batched) in [
         ("lanes", true, true),
         ("one_contact_at_a_time", true, false),

@@ -650,26 +650,9 @@ mod avx2_forces {
     /// [`contact_forces`]; the results are scattered as by [`wall_chunk_batched`]. Every
     /// lane runs the operations of `wall_touch` and `wall_kernel` in their order, so the
     /// results are bitwise theirs.
+    /// `R`: the groups' law is Hertz–Reissner ([`BlockWalls::plane_reissner`]), else Hertz.
     #[target_feature(enable = "avx2")]
-    pub(super) unsafe fn plane_slots<const E: u16>(
-        c: &WallCtx<'_>,
-        first: usize,
-        lists: BlockWalls<'_>,
-        slots: &mut [WallContact],
-        out: &mut [WallOut],
-        detail: &mut [WallDetail],
-        b: &mut Batch,
-    ) {
-        if lists.plane_reissner {
-            plane_slots_law::<E, true>(c, first, lists, slots, out, detail, b)
-        } else {
-            plane_slots_law::<E, false>(c, first, lists, slots, out, detail, b)
-        }
-    }
-
-    /// [`plane_slots`] for groups of Hertz (`R` false) or Hertz–Reissner (`R`) contacts.
-    #[inline(always)]
-    unsafe fn plane_slots_law<const E: u16, const R: bool>(
+    pub(super) unsafe fn plane_slots<const E: u16, const R: bool>(
         c: &WallCtx<'_>,
         first: usize,
         lists: BlockWalls<'_>,
@@ -1618,7 +1601,13 @@ pub(super) fn wall_chunk_batched<const E: u16>(
     #[cfg(target_arch = "x86_64")]
     if c.shared.avx2 {
         // SAFETY: `avx2` is set only when the CPU reported AVX2.
-        unsafe { avx2_forces::plane_slots::<E>(c, first, lists, slots, out, detail, b) };
+        unsafe {
+            if lists.plane_reissner {
+                avx2_forces::plane_slots::<E, true>(c, first, lists, slots, out, detail, b)
+            } else {
+                avx2_forces::plane_slots::<E, false>(c, first, lists, slots, out, detail, b)
+            }
+        };
     }
     let (out, detail) = (&mut out[..n_slots], &mut detail[..n_slots]);
     let mut next = 0usize;
