@@ -473,8 +473,6 @@ struct PairCtx<'a> {
     /// the constants and radii into its batch once per call instead of once per contact,
     /// and with AVX2 evaluates the law in its lanes.
     pairs_uniform: Option<(u32, f64)>,
-    /// The entry of `pairs_uniform` is a Hertz–Reissner law.
-    pairs_uniform_reissner: bool,
     /// The travel bound of this force evaluation, m (see [`Simulation::travel`]).
     travel: f64,
     /// A pair is skipped only if half its gap exceeds this, m: `SKIP_STEPS` times the
@@ -2314,10 +2312,6 @@ impl Simulation {
                 batched: self.batched,
                 pairs_hertz: self.pairs_hertz,
                 pairs_uniform: self.pairs_uniform,
-                pairs_uniform_reissner: self.pairs_uniform.is_some_and(|(k, _)| {
-                    self.contact_table.get(k as usize).map(|c| c.kind)
-                        == Some(LawKind::HertzReissner)
-                }),
                 travel: self.travel,
                 min_skip: SKIP_STEPS * self.travel_step,
             };
@@ -2760,9 +2754,9 @@ impl Simulation {
     }
 
     /// Whether the batched AVX2 pair kernel takes the uniform path: every pair indexes one
-    /// Hertz or Hertz–Reissner law entry and every sphere has one radius, so the constants and radii are
-    /// written into the batch once per chunk (a diagnostic; results are bitwise those of the
-    /// general path).
+    /// Hertz or Hertz–Reissner law entry and every sphere has one radius, so the constants
+    /// and radii are written into the batch once per chunk and the law is evaluated in the
+    /// lanes (a diagnostic; results are bitwise those of the general path).
     pub fn uniform_pairs(&self) -> bool {
         self.avx2 && self.batched && self.pairs_uniform.is_some()
     }

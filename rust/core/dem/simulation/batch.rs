@@ -1425,10 +1425,14 @@ pub(super) fn pair_chunk_batched<const E: u16, const U: bool>(
     let hertz = c.avx2 && c.pairs_hertz;
     // one law entry and one radius for every pair: written into the batch once per call
     let mut uniform_r_sum = 0.0;
+    // the uniform entry's law is Hertz–Reissner (else Hertz): the lanes evaluate that law
+    let mut reissner = false;
     if U {
         if let Some((k, r)) = c.pairs_uniform {
-            b.fill_uniform(&c.table[k as usize], r);
+            let konst = &c.table[k as usize];
+            b.fill_uniform(konst, r);
             uniform_r_sum = r + r;
+            reissner = konst.kind == LawKind::HertzReissner;
         }
     }
     let uniform_reach2 = uniform_r_sum * uniform_r_sum;
@@ -1520,7 +1524,7 @@ pub(super) fn pair_chunk_batched<const E: u16, const U: bool>(
             // SAFETY: `U` is set only with `avx2`, which is set only when the CPU reported
             // AVX2.
             rest = unsafe {
-                if c.pairs_uniform_reissner {
+                if reissner {
                     avx2_forces::uniform_pairs::<E, true>(b, c, chunk, active, out)
                 } else {
                     avx2_forces::uniform_pairs::<E, false>(b, c, chunk, active, out)
