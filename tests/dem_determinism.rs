@@ -256,12 +256,31 @@ fn batched_and_one_at_a_time_kernels_are_bitwise_identical() {
         }
         Simulation::new(&scene).unwrap()
     };
+    // the uniform pair kernel reads spins and springs from the particles' and pairs' rows
+    // only with the effects that use them: without rotation, and without friction (whose
+    // pairs keep a zero spring)
+    let without = |effect: Effect| {
+        move || {
+            let mut scene = anchor_scene(1e8, TableStart::PackedIntoFunnel).unwrap();
+            scene.threads = 2;
+            scene.record_onsets = true;
+            scene.effects = scene.effects.without(effect);
+            if effect == Effect::Friction {
+                for m in scene.materials.iter_mut() {
+                    m.friction = 0.0;
+                }
+            }
+            Simulation::new(&scene).unwrap()
+        }
+    };
     type Build = Box<dyn Fn() -> Simulation>;
-    let scenes: [(&str, Build); 4] = [
+    let scenes: [(&str, Build); 6] = [
         ("Hertz-Mindlin", Box::new(|| packed_soft(2))),
         ("Hertz-Reissner", Box::new(|| packed_soft_hertz_reissner(1))),
         ("moving walls", Box::new(oscillating)),
         ("polydisperse", Box::new(polydisperse)),
+        ("no rotation", Box::new(without(Effect::Rotation))),
+        ("frictionless", Box::new(without(Effect::Friction))),
     ];
     for (name, build) in scenes {
         for avx2 in [false, true] {

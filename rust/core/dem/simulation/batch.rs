@@ -310,6 +310,12 @@ mod avx2_forces {
     }
 
     #[inline(always)]
+    unsafe fn zero4() -> V4 {
+        let z = _mm256_setzero_pd();
+        V4 { x: z, y: z, z }
+    }
+
+    #[inline(always)]
     unsafe fn load(l: &Lanes3, k: usize) -> V4 {
         V4 {
             x: _mm256_loadu_pd(l.x.as_ptr().add(k)),
@@ -803,7 +809,10 @@ mod avx2_forces {
         let mut dst = [std::ptr::null_mut(); 4];
         for (l, d) in dst.iter_mut().enumerate() {
             let s = &mut slots[(g + l) * stride + q];
-            s.onset = false;
+            // (cleared only where set: a store to every slot costs more than the test)
+            if s.onset {
+                s.onset = false;
+            }
             *d = &mut s.history.x as *mut f64;
         }
         store_rows3(history, dst);
@@ -932,7 +941,10 @@ mod avx2_forces {
         for (l, d) in dst.iter_mut().enumerate() {
             let e = b.index[k + l] as usize;
             let p = &mut chunk[e];
-            p.onset = false;
+            // (cleared only where set: a store to every pair costs more than the test)
+            if p.onset {
+                p.onset = false;
+            }
             // force, torque per arm, overlap: 7 f64 from the start of the row
             let o = &mut out[e] as *mut PairOut as *mut f64;
             _mm_storeu_pd(o, lane_pair(fxy, l));
@@ -945,7 +957,9 @@ mod avx2_forces {
     }
 
     /// The pairs of a batch of uniform pairs ([`pair_chunk_batched`] with `U`) in one pass
-    /// over the lanes: geometry, forces and, for four pairs that go on in contact on a step
+    /// over the lanes: the particles' velocities and spins and the pairs' springs read from
+    /// their rows (the batch holds only the pairs' indices, x_j − x_i and its square),
+    /// geometry, forces and, for four pairs that go on in contact on a step
     /// without records, the scatter as rows ([`rows4`]), with no round trip through the
     /// batch. The other groups' results go to the batch for the lane-by-lane scatter;
     /// returns a bit per such group (group g: lanes 4g..4g + 4).
@@ -961,9 +975,43 @@ mod avx2_forces {
         let len = b.len.min(BATCH);
         let mut rest = 0u16;
         let mut k = 0;
+        // the rows of particles `idx` of `a` as lanes
+        let rows = |a: &[Vec3], idx: [usize; 4]| {
+            let p = |l: usize| a.as_ptr().add(idx[l]) as *const f64;
+            load_rows3([p(0), p(1), p(2), p(3)])
+        };
         while k < len {
-            let (n, overlap, spin) = geometry4::<E>(b, c, k);
-            let (v_rel, history) = (load(&b.v_rel, k), load(&b.history, k));
+            // SAFETY (the unchecked reads): every lane of the group, the padded ones past
+            // `len` too, names a pair of `chunk` (`pair_chunk_batched` pads them with the
+            // batch's first pair), whose particles passed the reach test, so they index
+            // the particle arrays, which are all as long as the positions.
+            let pc = |l: usize| chunk.get_unchecked(b.index[k + l] as usize);
+            let pi = [
+                pc(0).i as usize,
+                pc(1).i as usize,
+                pc(2).i as usize,
+                pc(3).i as usize,
+            ];
+            let pj = [
+                pc(0).j as usize,
+                pc(1).j as usize,
+                pc(2).j as usize,
+                pc(3).j as usize,
+            ];
+            let (omega_i, omega_j) = if rotation {
+                (rows(c.omega, pi), rows(c.omega, pj))
+            } else {
+                (zero4(), zero4())
+            };
+            let (d, dist2) = (load(&b.n, k), ld(&b.overlap, k));
+            let (n, overlap, spin) = geometry4_with::<E>(b, c, k, d, dist2, omega_i, omega_j);
+            let v_rel = sub(rows(c.velocity, pi), rows(c.velocity, pj));
+            let history = {
+                let p = |l: usize| {
+                    &chunk.get_unchecked(b.index[k + l] as usize).history.x as *const f64
+                };
+                load_rows3([p(0), p(1), p(2), p(3)])
+            };
             let f = forces4::<E, true, R>(b, c, k, n, v_rel, spin, overlap, history);
             let going_on = |l: usize| active.get(b.index[k + l] as usize) == Some(&true);
             if !c.detail && k + 4 <= len && going_on(0) && going_on(1) && going_on(2) && going_on(3)
@@ -981,10 +1029,14 @@ mod avx2_forces {
             } else {
                 store(&mut b.n, k, n);
                 st(&mut b.overlap, k, overlap);
+                store(&mut b.v_rel, k, v_rel);
                 if rotation {
                     store(&mut b.spin, k, spin);
                 }
                 store_forces::<E>(b, c, k, &f);
+                // (without friction `store_forces` leaves the spring, which the scatter
+                // writes back)
+                store(&mut b.history, k, f.history);
                 rest |= 1 << (k / 4);
             }
             k += 4;
@@ -997,8 +1049,27 @@ mod avx2_forces {
     #[inline(always)]
     unsafe fn geometry4<const E: u16>(b: &Batch, c: &PairCtx<'_>, k: usize) -> (V4, __m256d, V4) {
         let rotation = on::<E>(c.effects, Effect::Rotation);
-        let d = load(&b.n, k);
-        let dist = _mm256_sqrt_pd(ld(&b.overlap, k));
+        let (omega_i, omega_j) = if rotation {
+            (load(&b.omega_i, k), load(&b.omega_j, k))
+        } else {
+            (zero4(), zero4())
+        };
+        geometry4_with::<E>(b, c, k, load(&b.n, k), ld(&b.overlap, k), omega_i, omega_j)
+    }
+
+    /// [`geometry4`] with the spins ω_i, ω_j (rad/s) given as lanes.
+    #[inline(always)]
+    unsafe fn geometry4_with<const E: u16>(
+        b: &Batch,
+        c: &PairCtx<'_>,
+        k: usize,
+        d: V4,
+        dist2: __m256d,
+        omega_i: V4,
+        omega_j: V4,
+    ) -> (V4, __m256d, V4) {
+        let rotation = on::<E>(c.effects, Effect::Rotation);
+        let dist = _mm256_sqrt_pd(dist2);
         // f64::max(x, MIN_POSITIVE): maxpd returns its second operand for NaN, as max does
         let overlap = _mm256_max_pd(
             _mm256_sub_pd(ld(&b.r_sum, k), dist),
@@ -1010,10 +1081,7 @@ mod avx2_forces {
             let h = _mm256_mul_pd(_mm256_set1_pd(0.5), overlap);
             let arm_i = _mm256_sub_pd(ld(&b.r_i, k), h);
             let arm_j = _mm256_sub_pd(ld(&b.r_j, k), h);
-            spin = add(
-                scale(arm_i, load(&b.omega_i, k)),
-                scale(arm_j, load(&b.omega_j, k)),
-            );
+            spin = add(scale(arm_i, omega_i), scale(arm_j, omega_j));
         }
         (n, overlap, spin)
     }
@@ -1496,26 +1564,36 @@ pub(super) fn pair_chunk_batched<const E: u16, const U: bool>(
             b.index[k] = e as u32;
             b.n.set(k, d);
             b.overlap[k] = dist2;
+            if U {
+                // the velocities, spins and springs are read by `uniform_pairs` straight
+                // from their rows, four at a time: copies here, one f64 at a time, cost
+                // fifteen stores a pair (1.04× the step without them, stop 22)
+                continue;
+            }
             b.v_rel.set(k, velocity[i] - velocity[j]);
             if rotation {
                 b.omega_i.set(k, omega[i]);
                 b.omega_j.set(k, omega[j]);
             }
             b.history.set(k, p.history);
-            if !U {
-                b.r_sum[k] = p.r_sum;
-                if rotation {
-                    b.r_i[k] = radius[i];
-                    b.r_j[k] = radius[j];
-                }
-                if hertz {
-                    b.copy_constants(k, &c.table[konst[e] as usize], true);
-                } else {
-                    pending |= b.set_constants(k, &c.table[konst[e] as usize], c);
-                }
+            b.r_sum[k] = p.r_sum;
+            if rotation {
+                b.r_i[k] = radius[i];
+                b.r_j[k] = radius[j];
+            }
+            if hertz {
+                b.copy_constants(k, &c.table[konst[e] as usize], true);
+            } else {
+                pending |= b.set_constants(k, &c.table[konst[e] as usize], c);
             }
         }
         b.len = m;
+        if U && m > 0 {
+            // the last group's lanes past the batch read the rows of its first pair
+            for k in m..(m + 3) / 4 * 4 {
+                b.index[k] = b.index[0];
+            }
+        }
         // ---- overlaps and normals, laws, forces (uniform pairs: and the scatter of the
         // groups that go on, leaving the others to the loop below)
         let mut rest = u16::MAX;
