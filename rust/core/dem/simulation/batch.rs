@@ -1590,7 +1590,7 @@ pub(super) fn pair_chunk_batched<const E: u16, const U: bool>(
         b.len = m;
         if U && m > 0 {
             // the last group's lanes past the batch read the rows of its first pair
-            for k in m..(m + 3) / 4 * 4 {
+            for k in m..m.div_ceil(4) * 4 {
                 b.index[k] = b.index[0];
             }
         }
