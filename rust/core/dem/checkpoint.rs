@@ -260,6 +260,7 @@ impl Simulation {
             });
             pair_active.push(active);
         }
+        let pair_onset = vec![false; n_pairs];
         let stride = r.count(self.walls.len().max(1), "wall stride")?.max(1);
         let n_slots = r.count(n * stride, "wall slot")?;
         if n_slots != n * stride {
@@ -295,6 +296,7 @@ impl Simulation {
         self.reference_wall_offset = wall_ref;
         self.pairs = pairs;
         self.pair_active = pair_active;
+        self.pair_onset = pair_onset;
         self.wall_stride = stride;
         self.wall_slots = slots;
         self.build_gather_lists();

@@ -93,21 +93,21 @@ const SKIP_STEPS: f64 = 8.0;
 const PARTICLE_CHUNK: usize = 64;
 const NO_WALL: u32 = u32::MAX;
 
-/// A candidate particle pair of the Verlet list with the contact state the step carries: 48
-/// bytes, what the pair phase reads for every candidate (i, j, r_i + r_j) first. Whether the
-/// pair is in contact is kept apart, in [`Simulation::pair_active`] (one byte per pair; the
-/// gather visits only the pairs in contact, from lists of their own). What the step produces goes to [`PairOut`] (read by the gather) and, on
+/// A candidate particle pair of the Verlet list with the contact state the step carries: 32
+/// bytes, two to a cache line, what the pair phase reads for every candidate (i, j) and for
+/// every contact (the spring). Whether the pair is in contact, and whether its contact began
+/// at the last force evaluation, are kept apart, in [`Simulation::pair_active`] and
+/// [`Simulation::pair_onset`] (one byte per pair; the gather visits only the pairs in
+/// contact, from lists of their own), and r_i + r_j is read from the radii: at 48 bytes, with
+/// those two inside, the step's lines no longer fitted the 512 kB second-level cache of the
+/// machine here (stop 22). What the step produces goes to [`PairOut`] (read by the gather) and, on
 /// the last step of a [`Simulation::step`] call, to [`PairDetail`] (read only by the records),
 /// so a step streams as few cache lines as it can.
 #[derive(Debug, Clone, Copy, Default)]
-#[repr(C)]
+#[repr(C, align(32))]
 pub(crate) struct PairContact {
     pub(crate) i: u32,
     pub(crate) j: u32,
-    /// The contact began at the last force evaluation.
-    pub(crate) onset: bool,
-    /// r_i + r_j, m (derived from the radii at rebuild and restore; not checkpointed).
-    pub(crate) r_sum: f64,
     /// Tangential spring displacement ξ, m (Mindlin history).
     pub(crate) history: Vec3,
 }
@@ -346,6 +346,8 @@ pub struct Simulation {
     pub(crate) pairs: Vec<PairContact>,
     /// Whether each pair was in contact at the last force evaluation.
     pub(crate) pair_active: Vec<bool>,
+    /// Whether each pair's contact began at the last force evaluation.
+    pub(crate) pair_onset: Vec<bool>,
     /// Until when each pair out of contact cannot touch, in units of [`Simulation::travel`]
     /// (m): a pair last found a gap g apart when the travel was D cannot touch while the
     /// travel is below D + g/2 (less a rounding margin), because neither of its particles
@@ -407,6 +409,7 @@ pub struct Simulation {
     candidate_scratch: Vec<(u32, u32)>,
     old_pairs: Vec<PairContact>,
     old_pair_active: Vec<bool>,
+    old_pair_onset: Vec<bool>,
     old_slots: Vec<WallContact>,
     wall_state: Vec<WallState>,
     /// Contacts begun and ended in each chunk of `PAIR_CHUNK` pairs at the last force
@@ -558,6 +561,8 @@ struct Flips {
 struct PairLists<'a> {
     /// In contact at the last force evaluation.
     active: &'a mut [bool],
+    /// The contact began at the last force evaluation.
+    onset: &'a mut [bool],
     /// See [`Simulation::pair_wake`].
     wake: &'a mut [f64],
     out: &'a mut [PairOut],
@@ -772,6 +777,7 @@ fn law_at<const E: u16>(
 fn pair_in_reach(
     p: &mut PairContact,
     active: &mut bool,
+    onset: &mut bool,
     out: &mut PairOut,
     position: &[Vec3],
     reach2: f64,
@@ -784,7 +790,7 @@ fn pair_in_reach(
         let ended = *active;
         if ended {
             *active = false;
-            p.onset = false;
+            *onset = false;
             p.history = Vec3::ZERO;
             out.overlap = 0.0;
         }
@@ -894,13 +900,15 @@ fn wall_velocity<const E: u16>(wall: &Wall, ws: WallState, n: Vec3, effects: Eff
 fn pair_kernel<const E: u16>(
     p: &mut PairContact,
     active: &mut bool,
+    onset_flag: &mut bool,
     k: &ContactConst,
     out: &mut PairOut,
     detail: &mut PairDetail,
     rolling_torque: &mut Vec3,
     c: &PairCtx<'_>,
 ) -> Flips {
-    let (d, dist2) = match pair_in_reach(p, active, out, c.position, p.r_sum * p.r_sum) {
+    let r_sum = c.radius[p.i as usize] + c.radius[p.j as usize];
+    let (d, dist2) = match pair_in_reach(p, active, onset_flag, out, c.position, r_sum * r_sum) {
         Ok(hit) => hit,
         Err((_, ended)) => {
             return Flips {
@@ -910,7 +918,6 @@ fn pair_kernel<const E: u16>(
         }
     };
     let (i, j) = (p.i as usize, p.j as usize);
-    let r_sum = p.r_sum;
     let dist = dist2.sqrt();
     // rounding can give dist = r_sum for dist² just below r_sum²; keep the overlap positive,
     // the gather's activity test
@@ -926,7 +933,7 @@ fn pair_kernel<const E: u16>(
     let v_n = v_rel.dot(n); // > 0 approaching
     let onset = !*active;
     *active = true;
-    p.onset = onset;
+    *onset_flag = onset;
     let v_t = v_rel - v_n * n;
     if onset {
         detail.onset_normal_speed = v_n;
@@ -1007,21 +1014,23 @@ fn pair_chunk<const E: u16>(
     // `Simulation::pair_wake`, as the travel keeps growing)
     let PairLists {
         active,
+        onset,
         out,
         detail,
         rolling,
         ..
     } = lists;
-    for (e, (((((p, a), o), d), r), k)) in chunk
+    for (e, ((((((p, a), s), o), d), r), k)) in chunk
         .iter_mut()
         .zip(active.iter_mut())
+        .zip(onset.iter_mut())
         .zip(out.iter_mut())
         .zip(detail.iter_mut())
         .zip(rolling.iter_mut())
         .zip(konst)
         .enumerate()
     {
-        let f = pair_kernel::<E>(p, a, &c.table[*k as usize], o, d, r, c);
+        let f = pair_kernel::<E>(p, a, s, &c.table[*k as usize], o, d, r, c);
         if let Some(chunk_flips) = flips.get_mut(e / PAIR_CHUNK) {
             chunk_flips.onsets += f.onsets;
             chunk_flips.ends += f.ends;
@@ -1696,6 +1705,7 @@ impl Simulation {
             steps: 0,
             pairs: Vec::new(),
             pair_active: Vec::new(),
+            pair_onset: Vec::new(),
             pair_wake: Vec::new(),
             travel: 0.0,
             travel_slack: 0.0,
@@ -1724,6 +1734,7 @@ impl Simulation {
             candidate_scratch: Vec::new(),
             old_pairs: Vec::new(),
             old_pair_active: Vec::new(),
+            old_pair_onset: Vec::new(),
             old_slots: Vec::new(),
             wall_state: vec![WallState::default(); scene.walls.len()],
             chunk_flips: Vec::new(),
@@ -2001,7 +2012,6 @@ impl Simulation {
         for p in self.pairs.iter_mut() {
             let (i, j) = (p.i as usize, p.j as usize);
             let r_sum = self.radius[i] + self.radius[j];
-            p.r_sum = r_sum;
             let r_star = self.radius[i] * self.radius[j] / r_sum;
             let m_star = self.mass[i] * self.mass[j] / (self.mass[i] + self.mass[j]);
             let law = self.material[i] as usize * nm + self.material[j] as usize;
@@ -2149,8 +2159,10 @@ impl Simulation {
         );
         std::mem::swap(&mut self.pairs, &mut self.old_pairs);
         std::mem::swap(&mut self.pair_active, &mut self.old_pair_active);
+        std::mem::swap(&mut self.pair_onset, &mut self.old_pair_onset);
         self.pairs.clear();
         self.pair_active.clear();
+        self.pair_onset.clear();
         let mut old = 0usize;
         for &(i, j) in &self.candidate_scratch {
             // both lists are sorted by (i, j): merge to carry the state of surviving pairs
@@ -2164,6 +2176,7 @@ impl Simulation {
             {
                 self.pairs.push(self.old_pairs[old]);
                 self.pair_active.push(self.old_pair_active[old]);
+                self.pair_onset.push(self.old_pair_onset[old]);
             } else {
                 self.pairs.push(PairContact {
                     i,
@@ -2171,6 +2184,7 @@ impl Simulation {
                     ..Default::default()
                 });
                 self.pair_active.push(false);
+                self.pair_onset.push(false);
             }
         }
         self.build_gather_lists();
@@ -2326,6 +2340,7 @@ impl Simulation {
                 (&mut self.pairs, &mut self.pair_out, &self.pair_const);
             let (pair_detail, pair_rolling) = (&mut self.pair_detail, &mut self.pair_rolling);
             let (pair_active, pair_wake) = (&mut self.pair_active, &mut self.pair_wake);
+            let pair_onset = &mut self.pair_onset;
             let (flips, slots) = (&mut self.chunk_flips, &mut self.wall_slots);
             let (wall_out, wall_detail) = (&mut self.wall_out, &mut self.wall_detail);
             let cut = &self.cut_lists;
@@ -2379,6 +2394,7 @@ impl Simulation {
                 } = &self.cut_lists;
                 let mut parts = split_at_cuts(pairs, pair_cuts)
                     .zip(split_at_cuts(pair_active, pair_cuts))
+                    .zip(split_at_cuts(pair_onset, pair_cuts))
                     .zip(split_at_cuts(pair_wake, pair_cuts))
                     .zip(split_at_cuts(pair_out, pair_cuts))
                     .zip(split_at_cuts(pair_detail, pair_cuts))
@@ -2388,10 +2404,11 @@ impl Simulation {
                     .zip(split_at_cuts(wall_out, slot_cuts))
                     .zip(split_at_cuts(wall_detail, slot_cuts))
                     .map(
-                        |(((((((((p, a), k), o), d), r), on), s), wo), wd)| ForcePart {
+                        |((((((((((p, a), st), k), o), d), r), on), s), wo), wd)| ForcePart {
                             pairs: p,
                             lists: PairLists {
                                 active: a,
+                                onset: st,
                                 wake: k,
                                 out: o,
                                 detail: d,
@@ -2411,6 +2428,7 @@ impl Simulation {
                     pairs,
                     lists: PairLists {
                         active: pair_active,
+                        onset: pair_onset,
                         wake: pair_wake,
                         out: pair_out,
                         detail: pair_detail,
@@ -2564,11 +2582,12 @@ impl Simulation {
                 continue;
             }
             let end = ((c + 1) * PAIR_CHUNK).min(self.pairs.len());
-            for (p, d) in self.pairs[c * PAIR_CHUNK..end]
+            for ((p, d), &onset) in self.pairs[c * PAIR_CHUNK..end]
                 .iter()
                 .zip(&self.pair_detail[c * PAIR_CHUNK..end])
+                .zip(&self.pair_onset[c * PAIR_CHUNK..end])
             {
-                if p.onset {
+                if onset {
                     self.onsets.push(ContactOnset {
                         time,
                         step,

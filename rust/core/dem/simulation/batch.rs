@@ -914,11 +914,22 @@ mod avx2_forces {
         b: &Batch,
         k: usize,
         chunk: &mut [PairContact],
+        onset: &mut [bool],
         out: &mut [PairOut],
     ) {
         let (force, torque_per_arm) = (load(&b.force, k), load(&b.torque_per_arm, k));
         let (overlap, history) = (ld(&b.overlap, k), load(&b.history, k));
-        rows4(b, k, force, torque_per_arm, overlap, history, chunk, out);
+        rows4(
+            b,
+            k,
+            force,
+            torque_per_arm,
+            overlap,
+            history,
+            chunk,
+            onset,
+            out,
+        );
     }
 
     /// [`pair_rows`] from values in registers.
@@ -932,6 +943,7 @@ mod avx2_forces {
         overlap: __m256d,
         history: V4,
         chunk: &mut [PairContact],
+        onset: &mut [bool],
         out: &mut [PairOut],
     ) {
         let (fxy, fz_tx) = (lane_pairs(f.x, f.y), lane_pairs(f.z, t.x));
@@ -940,11 +952,11 @@ mod avx2_forces {
         let mut dst = [std::ptr::null_mut(); 4];
         for (l, d) in dst.iter_mut().enumerate() {
             let e = b.index[k + l] as usize;
-            let p = &mut chunk[e];
             // (cleared only where set: a store to every pair costs more than the test)
-            if p.onset {
-                p.onset = false;
+            if onset[e] {
+                onset[e] = false;
             }
+            let p = &mut chunk[e];
             // force, torque per arm, overlap: 7 f64 from the start of the row
             let o = &mut out[e] as *mut PairOut as *mut f64;
             _mm_storeu_pd(o, lane_pair(fxy, l));
@@ -969,6 +981,7 @@ mod avx2_forces {
         c: &PairCtx<'_>,
         chunk: &mut [PairContact],
         active: &[bool],
+        onset: &mut [bool],
         out: &mut [PairOut],
     ) -> u16 {
         let rotation = on::<E>(c.effects, Effect::Rotation);
@@ -1024,6 +1037,7 @@ mod avx2_forces {
                     overlap,
                     f.history,
                     chunk,
+                    onset,
                     out,
                 );
             } else {
@@ -1466,7 +1480,7 @@ const _: () = {
     assert!(offset_of!(ContactConst, c_n) == offset_of!(ContactConst, f_el) + 16);
     assert!(offset_of!(ContactConst, ct_ratio) == offset_of!(ContactConst, f_el) + 24);
     assert!(size_of::<WallOut>() == 48 && offset_of!(WallOut, torque) == 24);
-    assert!(size_of::<WallContact>() == 40 && size_of::<PairContact>() == 48);
+    assert!(size_of::<WallContact>() == 40 && size_of::<PairContact>() == 32);
     assert!(size_of::<PairOut>() == 64 && offset_of!(PairOut, force) == 0);
     assert!(offset_of!(PairOut, torque_per_arm) == 24 && offset_of!(PairOut, overlap) == 48);
 };
@@ -1506,8 +1520,9 @@ pub(super) fn pair_chunk_batched<const E: u16, const U: bool>(
     let uniform_reach2 = uniform_r_sum * uniform_r_sum;
     let travel = c.travel;
     let len = chunk.len();
-    let (active, wake, out, detail, konst) = (
+    let (active, onset_flags, wake, out, detail, konst) = (
         &mut lists.active[..len],
+        &mut lists.onset[..len],
         &mut lists.wake[..len],
         &mut lists.out[..len],
         &mut lists.detail[..len],
@@ -1543,9 +1558,14 @@ pub(super) fn pair_chunk_batched<const E: u16, const U: bool>(
             let e = base + awake.trailing_zeros() as usize;
             awake &= awake - 1;
             let p = &mut chunk[e];
-            let reach2 = if U { uniform_reach2 } else { p.r_sum * p.r_sum };
-            let (d, dist2) = match pair_in_reach(p, &mut active[e], &mut out[e], c.position, reach2)
-            {
+            let r_sum = if U {
+                uniform_r_sum
+            } else {
+                c.radius[p.i as usize] + c.radius[p.j as usize]
+            };
+            let reach2 = if U { uniform_reach2 } else { r_sum * r_sum };
+            let (a, s) = (&mut active[e], &mut onset_flags[e]);
+            let (d, dist2) = match pair_in_reach(p, a, s, &mut out[e], c.position, reach2) {
                 Ok(hit) => hit,
                 Err((dist2, ended)) => {
                     if ended {
@@ -1553,7 +1573,6 @@ pub(super) fn pair_chunk_batched<const E: u16, const U: bool>(
                             f.ends += 1;
                         }
                     }
-                    let r_sum = if U { uniform_r_sum } else { p.r_sum };
                     wake[e] = wake_travel(travel, dist2, r_sum, c.min_skip);
                     continue;
                 }
@@ -1576,7 +1595,7 @@ pub(super) fn pair_chunk_batched<const E: u16, const U: bool>(
                 b.omega_j.set(k, omega[j]);
             }
             b.history.set(k, p.history);
-            b.r_sum[k] = p.r_sum;
+            b.r_sum[k] = r_sum;
             if rotation {
                 b.r_i[k] = radius[i];
                 b.r_j[k] = radius[j];
@@ -1603,9 +1622,9 @@ pub(super) fn pair_chunk_batched<const E: u16, const U: bool>(
             // AVX2.
             rest = unsafe {
                 if reissner {
-                    avx2_forces::uniform_pairs::<E, true>(b, c, chunk, active, out)
+                    avx2_forces::uniform_pairs::<E, true>(b, c, chunk, active, onset_flags, out)
                 } else {
-                    avx2_forces::uniform_pairs::<E, false>(b, c, chunk, active, out)
+                    avx2_forces::uniform_pairs::<E, false>(b, c, chunk, active, onset_flags, out)
                 }
             };
         }
@@ -1634,7 +1653,7 @@ pub(super) fn pair_chunk_batched<const E: u16, const U: bool>(
                 && (0..4).all(|l| active.get(b.index[k + l] as usize) == Some(&true))
             {
                 // SAFETY: `avx2` is set only when the CPU reported AVX2.
-                unsafe { avx2_forces::pair_rows(b, k, chunk, out) };
+                unsafe { avx2_forces::pair_rows(b, k, chunk, onset_flags, out) };
                 k += 4;
                 continue;
             }
@@ -1642,7 +1661,7 @@ pub(super) fn pair_chunk_batched<const E: u16, const U: bool>(
             let p = &mut chunk[e];
             let onset = !active[e];
             active[e] = true;
-            p.onset = onset;
+            onset_flags[e] = onset;
             p.history = b.history.get(k);
             let d = &mut detail[e];
             if onset {
