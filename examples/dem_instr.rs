@@ -70,6 +70,7 @@ fn main() {
     sim.step(steps).unwrap();
     if timed {
         eprintln!("steps: {:.3} s", clock.elapsed().as_secs_f64());
+        eprintln!("blocks begin at particles {:?}", sim.block_cuts());
     }
     for (t, [force, particle]) in sim.phase_times().iter().enumerate() {
         eprintln!("thread {t}: force phase {force:.3} s, particle phase {particle:.3} s");

@@ -171,6 +171,9 @@ class DemSimulation:
     def phase_times(self) -> list[tuple[float, float]]:
         """(force phase s, particle phase s) of each engine thread's block since
         set_phase_timing(True)."""
+    def block_cuts(self) -> list[int]:
+        """First particle of each engine thread's block after the first (empty on one
+        thread); the cuts follow the measured times and never change the results."""
     def save_checkpoint(self, path: str | PathLike[str]) -> None: ...
     def load_checkpoint(self, path: str | PathLike[str]) -> None: ...
 

@@ -86,6 +86,19 @@ def test_phase_clock_reads_each_threads_blocks_and_changes_nothing():
     assert np.array_equal(a.positions(), b.positions())
 
 
+def test_block_cuts_name_where_each_threads_block_begins():
+    two = dem.DemSimulation.anchor_table(1e8, start="packed", threads=2)
+    one = dem.DemSimulation.anchor_table(1e8, start="packed", threads=1)
+    assert one.block_cuts() == []
+    two.step(400)
+    one.step(400)
+    cuts = two.block_cuts()
+    # one cut for two threads, inside the particle range and at a multiple of 16 particles
+    assert len(cuts) == 1 and 0 < cuts[0] < len(two.positions()) and cuts[0] % 16 == 0
+    # the cuts follow measured times; the results never depend on them
+    assert np.array_equal(two.positions(), one.positions())
+
+
 def test_outlet_plane_removes_particles():
     belt = dem.plane((0, 0, 0), (0, 0, 1), surface_velocity=(0.2, 0, 0))
     sim = dem.DemSimulation(np.array([[0.0, 0.0, R]]), np.array([R]), [GLASS], [belt], TABLE_EFFECTS,

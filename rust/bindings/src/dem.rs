@@ -711,6 +711,13 @@ impl DemSimulation {
             .collect()
     }
 
+    /// Where the engine's threads' blocks of particles begin (particle indices, one per
+    /// thread after the first; empty on one thread). The cuts follow each block's measured
+    /// time; they never change the results.
+    fn block_cuts(&self) -> Vec<usize> {
+        self.sim.block_cuts()
+    }
+
     /// Write a checkpoint atomically to `path`.
     fn save_checkpoint(&self, py: Python<'_>, path: PathBuf) -> CoreResult<()> {
         let sim = &self.sim;

@@ -19,7 +19,8 @@
 //! the blocks between cores every step (on two threads: 1.37× the speed of the work-stealing
 //! split, median of seven alternating rounds). The blocks are handed out with nested
 //! `rayon::join`s rather than a scope (1.03× on two threads, median of nine alternating
-//! rounds).
+//! rounds). Where the blocks are cut follows the time each block measured since the last
+//! cut (`Simulation::cut_blocks`); the results never depend on it.
 //!
 //! The kernels are monomorphised over the effect set (const generic `E`): the anchor table's
 //! set (with and without `planar`) gets a specialised step without effect tests in the inner
@@ -68,8 +69,9 @@ use batch::{pair_chunk_batched, wall_chunk_batched, Batch, BATCH, BATCH_SCRATCH}
 pub const PARALLEL_MIN_PARTICLES: usize = 256;
 /// Pairs per onset count: onsets and ends are counted per chunk of this many pairs, so the
 /// onset log and the gather lists find them without a full scan. A thread's block of pairs
-/// starts at a multiple of it. The kernels take a whole block in one call.
-const PAIR_CHUNK: usize = 256;
+/// starts at a multiple of it, so it is also the granularity of the pair cuts (256 left
+/// the default table's 2 000 pairs in eighths). The kernels take a whole block in one call.
+const PAIR_CHUNK: usize = 64;
 /// Estimated cost of a step's work, in instructions of the anchor table's profile, for the
 /// threads' cuts only (`Simulation::cut_blocks`): per particle (its update), per candidate
 /// pair (its tests) and per pair in contact on top (the kernel and two gather entries).
@@ -86,11 +88,15 @@ const SLOT_COST: u64 = 250;
 /// the anchor table (whose equal particle counts give the first thread 54 % of the cost
 /// and ran faster than an equal-cost cut, stop 19) stays where it was.
 const FIRST_BLOCK_EXTRA: u64 = 17;
+/// Parallel steps the blocks' times are measured over before they move a cut (see
+/// `Simulation::cut_blocks`): fewer would cut on noise.
+const BALANCE_MIN_STEPS: u64 = 50;
 /// The batched pair kernel skips a pair out of contact only while it cannot touch for at
 /// least this many steps at the last step's speed (see [`wake_travel`]).
 const SKIP_STEPS: f64 = 8.0;
-/// Granularity of the threads' particle blocks.
-const PARTICLE_CHUNK: usize = 64;
+/// Granularity of the threads' particle blocks (64 was too coarse for the measured cuts:
+/// 840 particles in steps of 64 swung the default table's cut between two chunks).
+const PARTICLE_CHUNK: usize = 16;
 const NO_WALL: u32 = u32::MAX;
 
 /// A candidate particle pair of the Verlet list with the contact state the step carries: 32
@@ -421,6 +427,13 @@ pub struct Simulation {
     /// Per block: nanoseconds spent in the force phase and in the particle phase, summed
     /// over steps; empty unless [`Simulation::set_phase_timing`] turned the clock on.
     phase_clock: Vec<[AtomicU64; 2]>,
+    /// The threads' cuts from measured times ([`Simulation::cut_blocks`]): per block,
+    /// nanoseconds of both phases since the blocks were last cut, busy and waiting to start
+    /// after the phase began (empty on one thread), the parallel steps they cover, and each
+    /// block's estimated cost at that cut.
+    balance_clock: Vec<[AtomicU64; 2]>,
+    balance_steps: u64,
+    balance_cost: Vec<f64>,
     pub(crate) contact_force_sum: Vec<Vec3>,
     pub(crate) coordination: Vec<u32>,
     pub(crate) wall_coordination: Vec<u32>,
@@ -660,16 +673,52 @@ where
     }
 }
 
-/// Adds the time since `start` (if the clock runs) to block `block`'s phase `phase`.
-fn clock_add(
-    clock: &[[AtomicU64; 2]],
-    block: usize,
-    phase: usize,
-    start: Option<std::time::Instant>,
-) {
-    if let (Some(start), Some(c)) = (start, clock.get(block)) {
-        let ns = u64::try_from(start.elapsed().as_nanos()).unwrap_or(u64::MAX);
-        c[phase].fetch_add(ns, Ordering::Relaxed);
+/// The clocks a step's phases add their time to: the phase clock of
+/// [`Simulation::set_phase_timing`] and the balance clock of the threads' cuts (each empty
+/// when off), with the instant the phase began (when a clock runs).
+#[derive(Clone, Copy)]
+struct Clocks<'a> {
+    phase: &'a [[AtomicU64; 2]],
+    balance: &'a [[AtomicU64; 2]],
+    began: Option<std::time::Instant>,
+}
+
+/// Nanoseconds from `a` to `b` (0 if `b` is earlier).
+fn nanos(a: std::time::Instant, b: std::time::Instant) -> u64 {
+    u64::try_from(b.saturating_duration_since(a).as_nanos()).unwrap_or(u64::MAX)
+}
+
+impl<'a> Clocks<'a> {
+    /// The clocks of a phase that begins now.
+    fn begin(phase: &'a [[AtomicU64; 2]], balance: &'a [[AtomicU64; 2]]) -> Self {
+        let on = !phase.is_empty() || !balance.is_empty();
+        Clocks {
+            phase,
+            balance,
+            began: on.then(std::time::Instant::now),
+        }
+    }
+
+    /// The start of a block's work, if any clock runs.
+    fn start(&self) -> Option<std::time::Instant> {
+        self.began.map(|_| std::time::Instant::now())
+    }
+
+    /// Adds the time since `start` to block `block`'s phase `phase`, and to the balance
+    /// clock also the wait from the phase's beginning to `start`.
+    fn add(&self, block: usize, phase: usize, start: Option<std::time::Instant>) {
+        let (Some(start), Some(began)) = (start, self.began) else {
+            return;
+        };
+        let now = std::time::Instant::now();
+        let busy = nanos(start, now);
+        if let Some(c) = self.phase.get(block) {
+            c[phase].fetch_add(busy, Ordering::Relaxed);
+        }
+        if let Some(c) = self.balance.get(block) {
+            c[0].fetch_add(busy, Ordering::Relaxed);
+            c[1].fetch_add(nanos(began, start), Ordering::Relaxed);
+        }
     }
 }
 
@@ -1740,6 +1789,9 @@ impl Simulation {
             chunk_flips: Vec::new(),
             chunk_results: Vec::new(),
             phase_clock: Vec::new(),
+            balance_clock: Vec::new(),
+            balance_steps: 0,
+            balance_cost: Vec::new(),
             contact_force_sum: vec![Vec3::ZERO; n],
             coordination: vec![0; n],
             wall_coordination: vec![0; n],
@@ -1903,49 +1955,71 @@ impl Simulation {
     }
 
     /// The threads' blocks of particles and pairs ([`CutLists::particle`], [`CutLists::pair`]),
-    /// at equal estimated cost rather than equal particle counts: where the pack has formed
-    /// among some particles while the others still ride the belt apart, as in the first
-    /// second of the default table, equal counts left one thread 2.3× the other's force
-    /// phase. The pairs go with their first particle, so each thread's gather reads mostly
-    /// rows its own core wrote. Needs the gather lists' `pair_start` and the wall slots.
+    /// at equal cost rather than equal particle counts: where the pack has formed among some
+    /// particles while the others still ride the belt apart, as in the first second of the
+    /// default table, equal counts left one thread 2.3× the other's force phase. The first
+    /// cut is at equal estimated cost ([`Simulation::particle_costs`]). Once the blocks have
+    /// been timed over `BALANCE_MIN_STEPS` parallel steps, each particle's estimate is
+    /// scaled by its block's measured time per unit of estimate, and the cuts go where
+    /// every block would end at the same time ([`Simulation::measured_balance`]); until
+    /// then the cut stays. The estimates alone still left one thread 1.3–1.9× the other's
+    /// force phase in the default table (stop 22). The pairs go with their first particle,
+    /// so each thread's gather reads mostly rows its own core wrote. Results do not depend
+    /// on the cuts. Needs the gather lists' `pair_start` and the wall slots.
     fn cut_blocks(&mut self) {
         let n = self.position.len();
         let parts = self.threads.max(1);
-        let stride = self.wall_stride.max(1);
-        let contact_cost = match self.model {
-            ContactModel::HertzReissnerMindlin => CONTACT_COST_REISSNER,
-            _ => CONTACT_COST,
+        let cost = self.particle_costs();
+
+        // the estimates scaled by what each block's particles measured since the last cut;
+        // while too few steps are measured, the cut stays (a window longer than the time
+        // between rebuilds: early in a run these come every few dozen steps)
+        let measured = self.measured_balance(parts);
+        let old = &self.cut_lists.particle;
+        let measuring = parts > 1
+            && old.len() == parts - 1
+            && self.balance_clock.len() == parts
+            && self.balance_steps < BALANCE_MIN_STEPS;
+        let weight: Vec<f64> = match &measured {
+            Some((rate, _)) => {
+                let mut b = 0;
+                let mut weight = Vec::with_capacity(n);
+                for (i, &c) in cost.iter().enumerate() {
+                    while b < old.len() && i >= old[b] {
+                        b += 1;
+                    }
+                    weight.push(c as f64 * rate[b]);
+                }
+                weight
+            }
+            None => cost.iter().map(|&c| c as f64).collect(),
         };
-        let mut cost = vec![PARTICLE_COST; n];
-        for (p, &on) in self.pairs.iter().zip(&self.pair_active) {
-            if let Some(c) = cost.get_mut(p.i as usize) {
-                *c += PAIR_COST + contact_cost * u64::from(on);
+        let total: f64 = weight.iter().sum();
+        // where each cut sits, as a fraction of the total: measured, the shares that end
+        // every block at the same time; on estimates alone, the calling thread (which starts
+        // its block first, the others taking theirs from the join) gets FIRST_BLOCK_EXTRA
+        // hundredths of a block more, cut t at (t + x)/(parts + x)
+        let bounds: Vec<f64> = match &measured {
+            Some((_, bounds)) => bounds.clone(),
+            None => {
+                let x = FIRST_BLOCK_EXTRA as f64;
+                let whole = 100.0 * parts as f64 + x;
+                (1..parts).map(|t| (100.0 * t as f64 + x) / whole).collect()
             }
-        }
-        for (c, row) in cost.iter_mut().zip(self.wall_slots.chunks_exact(stride)) {
-            for s in row.iter().take_while(|s| s.wall != NO_WALL) {
-                let plane = matches!(
-                    self.walls.get(s.wall as usize).map(|w| &w.shape),
-                    Some(WallShape::Plane { .. })
-                );
-                *c += if plane { PLANE_SLOT_COST } else { SLOT_COST };
-            }
-        }
-        let total: u64 = cost.iter().sum();
-        // the calling thread starts its block first (the others take theirs from the join):
-        // it gets FIRST_BLOCK_EXTRA of a block more (cut t at (t + x)/(parts + x) of the
-        // cost, in hundredths)
-        let (x, whole) = (FIRST_BLOCK_EXTRA, 100 * parts as u64 + FIRST_BLOCK_EXTRA);
+        };
         let mut at = Vec::with_capacity(parts.saturating_sub(1));
-        let (mut t, mut sum) = (1usize, 0u64);
-        for (i, &c) in cost.iter().enumerate() {
-            while t < parts && sum * whole >= total * (100 * t as u64 + x) {
+        let (mut t, mut sum) = (0usize, 0.0);
+        for (i, &w) in weight.iter().enumerate() {
+            while t < bounds.len() && sum >= total * bounds[t] {
                 at.push(i);
                 t += 1;
             }
-            sum += c;
+            sum += w;
         }
         at.resize(parts.saturating_sub(1), n);
+        if measuring {
+            at.clone_from(old);
+        }
         let cuts = &mut self.cut_lists;
         cuts.particle.clear();
         cuts.pair.clear();
@@ -1962,6 +2036,86 @@ impl Simulation {
             cuts.particle.push(p);
             cuts.pair.push(e);
         }
+        if measuring {
+            return;
+        }
+        // a new window of measurement for the new blocks
+        self.balance_clock.clear();
+        self.balance_cost.clear();
+        self.balance_steps = 0;
+        if parts > 1 {
+            self.balance_clock
+                .extend((0..parts).map(|_| [AtomicU64::new(0), AtomicU64::new(0)]));
+            let mut from = 0;
+            for b in 0..parts {
+                let to = self.cut_lists.particle.get(b).copied().unwrap_or(n).min(n);
+                let block = cost.get(from..to).unwrap_or(&[]);
+                self.balance_cost.push(block.iter().sum::<u64>() as f64);
+                from = to.max(from);
+            }
+        }
+    }
+
+    /// Each particle's estimated cost of a step: its update, its candidate pairs and pairs
+    /// in contact (those it is the first particle of), its wall slots.
+    fn particle_costs(&self) -> Vec<u64> {
+        let stride = self.wall_stride.max(1);
+        let contact_cost = match self.model {
+            ContactModel::HertzReissnerMindlin => CONTACT_COST_REISSNER,
+            _ => CONTACT_COST,
+        };
+        let mut cost = vec![PARTICLE_COST; self.position.len()];
+        for (p, &on) in self.pairs.iter().zip(&self.pair_active) {
+            if let Some(c) = cost.get_mut(p.i as usize) {
+                *c += PAIR_COST + contact_cost * u64::from(on);
+            }
+        }
+        for (c, row) in cost.iter_mut().zip(self.wall_slots.chunks_exact(stride)) {
+            for s in row.iter().take_while(|s| s.wall != NO_WALL) {
+                let plane = matches!(
+                    self.walls.get(s.wall as usize).map(|w| &w.shape),
+                    Some(WallShape::Plane { .. })
+                );
+                *c += if plane { PLANE_SLOT_COST } else { SLOT_COST };
+            }
+        }
+        cost
+    }
+
+    /// What the blocks measured since they were last cut: each block's busy time per unit
+    /// of estimated cost (ns), and where the cuts go (as fractions of the total busy time)
+    /// for every block to end at the same time, the later starts of the blocks that wait
+    /// for a thread included: block b's busy time becomes (Σ busy + Σ wait)/parts − wait_b.
+    /// `None` on one thread, after fewer than `BALANCE_MIN_STEPS` parallel steps, or where a
+    /// block has no time or no cost.
+    fn measured_balance(&self, parts: usize) -> Option<(Vec<f64>, Vec<f64>)> {
+        if parts < 2
+            || self.balance_steps < BALANCE_MIN_STEPS
+            || self.balance_clock.len() != parts
+            || self.balance_cost.len() != parts
+            || self.cut_lists.particle.len() != parts - 1
+        {
+            return None;
+        }
+        let (mut rate, mut wait) = (Vec::with_capacity(parts), Vec::with_capacity(parts));
+        let mut busy_total = 0.0;
+        for (clock, &cost) in self.balance_clock.iter().zip(&self.balance_cost) {
+            let busy = clock[0].load(Ordering::Relaxed) as f64;
+            if busy <= 0.0 || cost <= 0.0 {
+                return None;
+            }
+            rate.push(busy / cost);
+            wait.push(clock[1].load(Ordering::Relaxed) as f64);
+            busy_total += busy;
+        }
+        let end = (busy_total + wait.iter().sum::<f64>()) / parts as f64;
+        let mut bounds = Vec::with_capacity(parts - 1);
+        let mut sum = 0.0;
+        for w in &wait[..parts - 1] {
+            sum += (end - w).max(0.0);
+            bounds.push((sum / busy_total).min(1.0));
+        }
+        Some((rate, bounds))
     }
 
     /// The cut positions of [`CutLists`] that follow from its particle and pair cuts and the
@@ -2295,6 +2449,9 @@ impl Simulation {
         if self.wall_lists.mode != Some((parallel, self.avx2, self.batched)) {
             self.list_wall_slots(parallel);
         }
+        if parallel {
+            self.balance_steps += 1;
+        }
         match self.effects.bits() {
             TABLE => self.force_and_advance::<TABLE>(parallel),
             TABLE_PLANAR => self.force_and_advance::<TABLE_PLANAR>(parallel),
@@ -2347,9 +2504,12 @@ impl Simulation {
             let wall_lists = &self.wall_lists;
             flips.clear();
             flips.resize(pairs.len().div_ceil(PAIR_CHUNK), Flips::default());
-            let clock = &self.phase_clock;
+            let clock = Clocks::begin(
+                &self.phase_clock,
+                if parallel { &self.balance_clock } else { &[] },
+            );
             let run = |(t, part): (usize, ForcePart<'_>)| {
-                let start = (!clock.is_empty()).then(std::time::Instant::now);
+                let start = clock.start();
                 let (first_particle, first_pair) = match t.checked_sub(1) {
                     Some(b) => (cut.particle[b], cut.pair[b]),
                     None => (0, 0),
@@ -2380,7 +2540,7 @@ impl Simulation {
                     let (s, o, d) = (part.slots, part.wall_out, part.wall_detail);
                     simd::wall::<E>(avx2, &wall_ctx, first_particle, block, s, o, d, b)
                 });
-                clock_add(clock, t, 0, start);
+                clock.add(t, 0, start);
             };
             if parallel {
                 // one part per thread: the pairs whose first particle is in a block of
@@ -2496,19 +2656,20 @@ impl Simulation {
                     ),
                     &'c mut [(f64, f64, bool, u32)],
                 );
-                let clock = &self.phase_clock;
+                let clock = Clocks::begin(&self.phase_clock, &self.balance_clock);
                 let run = |(t, ((((((x, v), w), f), z), zw), res)): (usize, Part<'_>)| {
-                    let start = (!clock.is_empty()).then(std::time::Instant::now);
+                    let start = clock.start();
                     let first = if t == 0 { 0 } else { cuts[t - 1] };
                     let len = x.len();
                     let slots = &slots[first * stride..(first + len) * stride];
                     let outs = &outs[first * stride..(first + len) * stride];
                     res[0] = simd::particle::<E>(avx2, &ctx, first, x, v, w, f, z, zw, slots, outs);
-                    clock_add(clock, t, 1, start);
+                    clock.add(t, 1, start);
                 };
                 join_parts(&mut parts, &run);
             } else {
-                let start = (!self.phase_clock.is_empty()).then(std::time::Instant::now);
+                let clock = Clocks::begin(&self.phase_clock, &[]);
+                let start = clock.start();
                 let result = simd::particle::<E>(
                     avx2,
                     &ctx,
@@ -2522,7 +2683,7 @@ impl Simulation {
                     &self.wall_slots,
                     &self.wall_out,
                 );
-                clock_add(&self.phase_clock, 0, 1, start);
+                clock.add(0, 1, start);
                 self.chunk_results.clear();
                 self.chunk_results.push(result);
             }
@@ -2745,6 +2906,17 @@ impl Simulation {
                     .map(|a| a.load(Ordering::Relaxed) as f64 * 1e-9)
             })
             .collect()
+    }
+
+    /// Where the threads' blocks of particles begin: one particle index per block after
+    /// the first (empty on one thread). The cuts start from estimated costs and follow the
+    /// blocks' measured times ([`Simulation::cut_blocks`]); results do not depend on them.
+    pub fn block_cuts(&self) -> Vec<usize> {
+        if self.threads > 1 {
+            self.cut_lists.particle.clone()
+        } else {
+            Vec::new()
+        }
     }
 
     /// How many particle–wall slots the AVX2 plane pass took in the last step (four particles
@@ -3081,4 +3253,88 @@ pub fn stable_time_step(scene: &Scene, mass: &[f64]) -> Result<StableStep> {
         best.limit = f64::MAX;
     }
     Ok(best)
+}
+
+#[cfg(test)]
+mod balance_tests {
+    use super::*;
+    use crate::dem::table::{anchor_scene, TableStart};
+
+    fn packed(threads: usize) -> Simulation {
+        let mut scene = anchor_scene(1e8, TableStart::PackedIntoFunnel).unwrap();
+        scene.threads = threads;
+        Simulation::new(&scene).unwrap()
+    }
+
+    fn bits(sim: &Simulation) -> Vec<u64> {
+        let mut out = Vec::new();
+        for v in sim.positions().iter().chain(sim.velocities()) {
+            out.extend([v.x.to_bits(), v.y.to_bits(), v.z.to_bits()]);
+        }
+        out
+    }
+
+    /// Pretend the blocks measured `busy` and `wait` (ns) over `steps` steps, and cut again.
+    fn recut(sim: &mut Simulation, busy: [u64; 2], wait: [u64; 2], steps: u64) {
+        for (c, (b, w)) in sim.balance_clock.iter().zip(busy.iter().zip(wait)) {
+            c[0].store(*b, Ordering::Relaxed);
+            c[1].store(w, Ordering::Relaxed);
+        }
+        sim.balance_steps = steps;
+        sim.cut_blocks();
+        sim.derive_cut_lists();
+        sim.wall_lists.mode = None;
+    }
+
+    #[test]
+    fn cuts_follow_measured_times_and_change_no_result() {
+        let mut a = packed(2);
+        let mut reference = packed(1);
+        a.step(60).unwrap();
+        reference.step(60).unwrap();
+        let start = a.block_cuts();
+        assert_eq!(start.len(), 1);
+        let (est0, est1) = (a.balance_cost[0], a.balance_cost[1]);
+        assert!(est0 > 0.0 && est1 > 0.0);
+        // too few steps measured: the cut stays
+        recut(
+            &mut a,
+            [3_000_000, 1_000_000],
+            [0, 0],
+            BALANCE_MIN_STEPS - 1,
+        );
+        assert_eq!(a.block_cuts(), start);
+        // the first block twice as slow per unit of cost as the second, no waits: its cut
+        // moves down until the predicted busy times (cost × the rate of the block each
+        // particle was in) are equal, to within one chunk of particles
+        let costs: Vec<f64> = a.particle_costs().iter().map(|&c| c as f64).collect();
+        recut(&mut a, [(2.0 * est0) as u64, est1 as u64], [0, 0], 100);
+        let cut = a.block_cuts()[0];
+        assert!(cut < start[0], "cut {cut} not below {}", start[0]);
+        let rate = |i: usize| if i < start[0] { 2.0 } else { 1.0 };
+        let t0: f64 = (0..cut).map(|i| costs[i] * rate(i)).sum();
+        let t1: f64 = (cut..costs.len()).map(|i| costs[i] * rate(i)).sum();
+        let chunk = (0..costs.len() / PARTICLE_CHUNK)
+            .map(|c| {
+                (c * PARTICLE_CHUNK..(c + 1) * PARTICLE_CHUNK)
+                    .map(|i| costs[i] * rate(i))
+                    .sum::<f64>()
+            })
+            .fold(0.0, f64::max);
+        assert!(
+            (t0 - t1).abs() <= chunk,
+            "predicted busy {t0} / {t1}, chunk {chunk}"
+        );
+        // equal rates, but the second block starts 20 % of a block late: the first block
+        // takes more than half
+        let (e0, e1) = (a.balance_cost[0], a.balance_cost[1]);
+        let wait = 0.2 * (e0 + e1) / 2.0;
+        recut(&mut a, [e0 as u64, e1 as u64], [0, wait as u64], 100);
+        let (f0, f1) = (a.balance_cost[0], a.balance_cost[1]);
+        assert!(f0 > f1, "first block {f0}, second {f1}");
+        // whatever the cuts, the results are those of one thread
+        a.step(300).unwrap();
+        reference.step(300).unwrap();
+        assert_eq!(bits(&a), bits(&reference));
+    }
 }
