@@ -1970,56 +1970,18 @@ impl Simulation {
         let n = self.position.len();
         let parts = self.threads.max(1);
         let cost = self.particle_costs();
-
-        // the estimates scaled by what each block's particles measured since the last cut;
-        // while too few steps are measured, the cut stays (a window longer than the time
-        // between rebuilds: early in a run these come every few dozen steps)
-        let measured = self.measured_balance(parts);
+        // while too few parallel steps are measured the cut stays (a window longer than the
+        // time between rebuilds: early in a run these come every few dozen steps)
         let old = &self.cut_lists.particle;
         let measuring = parts > 1
             && old.len() == parts - 1
             && self.balance_clock.len() == parts
             && self.balance_steps < BALANCE_MIN_STEPS;
-        let weight: Vec<f64> = match &measured {
-            Some((rate, _)) => {
-                let mut b = 0;
-                let mut weight = Vec::with_capacity(n);
-                for (i, &c) in cost.iter().enumerate() {
-                    while b < old.len() && i >= old[b] {
-                        b += 1;
-                    }
-                    weight.push(c as f64 * rate[b]);
-                }
-                weight
-            }
-            None => cost.iter().map(|&c| c as f64).collect(),
+        let at = if measuring {
+            old.clone()
+        } else {
+            self.cut_positions(&cost, parts)
         };
-        let total: f64 = weight.iter().sum();
-        // where each cut sits, as a fraction of the total: measured, the shares that end
-        // every block at the same time; on estimates alone, the calling thread (which starts
-        // its block first, the others taking theirs from the join) gets FIRST_BLOCK_EXTRA
-        // hundredths of a block more, cut t at (t + x)/(parts + x)
-        let bounds: Vec<f64> = match &measured {
-            Some((_, bounds)) => bounds.clone(),
-            None => {
-                let x = FIRST_BLOCK_EXTRA as f64;
-                let whole = 100.0 * parts as f64 + x;
-                (1..parts).map(|t| (100.0 * t as f64 + x) / whole).collect()
-            }
-        };
-        let mut at = Vec::with_capacity(parts.saturating_sub(1));
-        let (mut t, mut sum) = (0usize, 0.0);
-        for (i, &w) in weight.iter().enumerate() {
-            while t < bounds.len() && sum >= total * bounds[t] {
-                at.push(i);
-                t += 1;
-            }
-            sum += w;
-        }
-        at.resize(parts.saturating_sub(1), n);
-        if measuring {
-            at.clone_from(old);
-        }
         let cuts = &mut self.cut_lists;
         cuts.particle.clear();
         cuts.pair.clear();
@@ -2054,6 +2016,54 @@ impl Simulation {
                 from = to.max(from);
             }
         }
+    }
+
+    /// Where the blocks of `parts` threads begin (particle indices, before rounding), given
+    /// each particle's estimated cost: at equal measured time once the blocks have been
+    /// timed ([`Simulation::measured_balance`]), the estimates of each block's particles
+    /// scaled by its measured time per unit of estimate; at equal estimated cost otherwise.
+    fn cut_positions(&self, cost: &[u64], parts: usize) -> Vec<usize> {
+        let n = cost.len();
+        let measured = self.measured_balance(parts);
+        let old = &self.cut_lists.particle;
+        let weight: Vec<f64> = match &measured {
+            Some((rate, _)) => {
+                let mut b = 0;
+                let mut weight = Vec::with_capacity(n);
+                for (i, &c) in cost.iter().enumerate() {
+                    while b < old.len() && i >= old[b] {
+                        b += 1;
+                    }
+                    weight.push(c as f64 * rate[b]);
+                }
+                weight
+            }
+            None => cost.iter().map(|&c| c as f64).collect(),
+        };
+        let total: f64 = weight.iter().sum();
+        // where each cut sits, as a fraction of the total: measured, the shares that end
+        // every block at the same time; on estimates alone, the calling thread (which starts
+        // its block first, the others taking theirs from the join) gets FIRST_BLOCK_EXTRA
+        // hundredths of a block more, cut t at (t + x)/(parts + x)
+        let bounds: Vec<f64> = match measured {
+            Some((_, bounds)) => bounds,
+            None => {
+                let x = FIRST_BLOCK_EXTRA as f64;
+                let whole = 100.0 * parts as f64 + x;
+                (1..parts).map(|t| (100.0 * t as f64 + x) / whole).collect()
+            }
+        };
+        let mut at = Vec::with_capacity(parts.saturating_sub(1));
+        let (mut t, mut sum) = (0usize, 0.0);
+        for (i, &w) in weight.iter().enumerate() {
+            while t < bounds.len() && sum >= total * bounds[t] {
+                at.push(i);
+                t += 1;
+            }
+            sum += w;
+        }
+        at.resize(parts.saturating_sub(1), n);
+        at
     }
 
     /// Each particle's estimated cost of a step: its update, its candidate pairs and pairs

@@ -1019,12 +1019,8 @@ mod avx2_forces {
             let (d, dist2) = (load(&b.n, k), ld(&b.overlap, k));
             let (n, overlap, spin) = geometry4_with::<E>(b, c, k, d, dist2, omega_i, omega_j);
             let v_rel = sub(rows(c.velocity, pi), rows(c.velocity, pj));
-            let history = {
-                let p = |l: usize| {
-                    &chunk.get_unchecked(b.index[k + l] as usize).history.x as *const f64
-                };
-                load_rows3([p(0), p(1), p(2), p(3)])
-            };
+            let spring = |l: usize| &pc(l).history.x as *const f64;
+            let history = load_rows3([spring(0), spring(1), spring(2), spring(3)]);
             let f = forces4::<E, true, R>(b, c, k, n, v_rel, spin, overlap, history);
             let going_on = |l: usize| active.get(b.index[k + l] as usize) == Some(&true);
             if !c.detail && k + 4 <= len && going_on(0) && going_on(1) && going_on(2) && going_on(3)
