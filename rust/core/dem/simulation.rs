@@ -3291,9 +3291,8 @@ mod balance_tests {
             c[1].store(w, Ordering::Relaxed);
         }
         sim.balance_steps = steps;
-        sim.cut_blocks();
-        sim.derive_cut_lists();
-        sim.wall_lists.mode = None;
+        // what a rebuild runs after listing the pairs and slots
+        sim.refresh_contact_constants();
     }
 
     #[test]
