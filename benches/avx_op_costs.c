@@ -14,6 +14,45 @@ static double now(void) {
     return t.tv_sec + 1e-9 * t.tv_nsec;
 }
 
+/* Latencies (stop 23): one dependent chain. A square root or division alternates with a
+ * multiply by 1.7, so the chain's values stay away from 1 (a square root of exactly 1 would
+ * take a short cut); the multiply's own latency, measured alone, is subtracted. Both
+ * registers are loaded in each block: the printf between blocks may clobber them. */
+static void latencies(long n) {
+    static const double c[4] = {1.7, 1.7, 1.7, 1.7};
+    static const double x0[4] = {2.3, 2.5, 2.7, 2.1};
+    double t0, t1, mul;
+    __asm__ volatile("vmovupd (%0),%%ymm1\n"
+                     "vmovupd (%1),%%ymm2\n" ::"r"(x0), "r"(c)
+                     : "xmm1", "xmm2");
+    t0 = now();
+    for (long i = 0; i < n; i++) {
+        __asm__ volatile("vmulpd %%ymm2,%%ymm1,%%ymm1\n"
+                         "vmulpd %%ymm2,%%ymm1,%%ymm1\n"
+                         "vmulpd %%ymm2,%%ymm1,%%ymm1\n"
+                         "vmulpd %%ymm2,%%ymm1,%%ymm1\n" ::: "xmm1");
+    }
+    t1 = now();
+    mul = (t1 - t0) / n / 4 * 1e9;
+    printf("latency, one dependent chain:\n");
+    printf("%-38s %7.3f ns\n", "vmulpd ymm", mul);
+#define LATENCY(name, op)                                                                       \
+    __asm__ volatile("vmovupd (%0),%%ymm1\n"                                                   \
+                     "vmovupd (%1),%%ymm2\n" ::"r"(x0), "r"(c)                                  \
+                     : "xmm1", "xmm2");                                                         \
+    t0 = now();                                                                                 \
+    for (long i = 0; i < n; i++) {                                                              \
+        __asm__ volatile(op "\n" ::: "xmm1", "xmm2");                                           \
+    }                                                                                           \
+    t1 = now();                                                                                 \
+    printf("%-38s %7.3f ns\n", name, (t1 - t0) / n * 1e9 - mul);
+    LATENCY("vsqrtpd ymm", "vsqrtpd %%ymm1,%%ymm1\n vmulpd %%ymm2,%%ymm1,%%ymm1")
+    LATENCY("vsqrtpd xmm", "vsqrtpd %%xmm1,%%xmm1\n vmulpd %%xmm2,%%xmm1,%%xmm1")
+    LATENCY("vdivpd ymm", "vdivpd %%ymm1,%%ymm2,%%ymm1\n vmulpd %%ymm2,%%ymm1,%%ymm1")
+    LATENCY("vdivpd xmm", "vdivpd %%xmm1,%%xmm2,%%xmm1\n vmulpd %%xmm2,%%xmm1,%%xmm1")
+#undef LATENCY
+}
+
 int main(void) {
     static const double v[4] = {1.234e-7, 2.3e-7, 3.1e-7, 7.7e-8};
     static const double w[4] = {0.7, 1.3, 2.9, 0.11};
@@ -188,5 +227,6 @@ int main(void) {
     t1 = now();
     printf("%-38s %7.3f ns/op  (%.2f vmulpd)\n", "vdivpd xmm", (t1 - t0) / n / 8 * 1e9,
            (t1 - t0) / n / 8 * 1e9 / mul);
+    latencies(n);
     return 0;
 }
