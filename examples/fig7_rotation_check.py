@@ -24,7 +24,7 @@ import numpy as np
 
 from demfem.analysis import tag_mask
 from demfem.dem import from_scene
-from demfem.io import savefig_atomic, write_text_atomic
+from demfem.io import savefig_atomic, write_json_atomic
 from demfem.scenes.table import Tag
 from demfem.studies.figures import FIG6_SETUP, SWEEP_GEOMETRY, speed_windows
 from demfem.studies.table_run import table_from_params
@@ -32,7 +32,8 @@ from demfem.studies.table_run import table_from_params
 
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--E", type=float, default=1e7, help="Young's modulus, Pa (1e7)")
+    p.add_argument("--E", "--young-modulus", dest="E", type=float, default=1e7,
+                   help="Young's modulus, Pa (1e7)")
     p.add_argument("--duration", type=float, default=20.0, help="simulated time, s (20)")
     p.add_argument("--sample-interval", type=float, default=0.05, help="s (0.05)")
     p.add_argument("--window", type=float, default=5.0, help="averaging window, s (5)")
@@ -63,7 +64,7 @@ def main() -> None:
              "rectangular_centre": speed_windows(t, s_rect, a.window),
              "all_spheres_mean": speed_windows(t, s_all, a.window),
              "removed": int(len(scene.radii) - np.count_nonzero(sim.alive()))}
-    write_text_atomic(out / "fig7_rotation_check.json", json.dumps(found, indent=1) + "\n")
+    write_json_atomic(out / "fig7_rotation_check.json", found)
 
     import matplotlib
 

@@ -19,7 +19,7 @@ __all__ = [
     "fem_solve_static",
     "fem_stress_invariants",
     "fem_tet_mesh",
-    "hertz_contact_duration",
+    "hertz_impact_duration",
     "max_impact_force",
     "normal_force",
     "rayleigh_time_step",
@@ -29,19 +29,22 @@ __all__ = [
 ]
 
 def normal_force(
-    law: str,
-    overlap: npt.NDArray[np.float64],
+    overlap: npt.ArrayLike,
+    model: str,
     k_h: float = ...,
     k_r: float = ...,
     k: float = ...,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
-    """Normal force (N) and tangent stiffness (N/m) of ``law`` at each overlap (m).
-    ``law`` in {'hertz', 'linear', 'hertz_reissner'}; k_h in N/m^1.5, k_r and k in N/m."""
+    """Normal force (N) and tangent stiffness (N/m) of law ``model`` at each overlap (m), in
+    the argument order of :func:`demfem.contact.normal_force`. ``model`` in {'hertz',
+    'linear', 'hertz_reissner'}; k_h in N/m^1.5, k_r and k in N/m. A NaN or infinite overlap
+    raises InvalidParameterError naming ``overlap[i]``."""
 
 def max_impact_force(
-    law: str, m_star: float, v_rel: float, k_h: float = ..., k_r: float = ..., k: float = ...
+    m_star: float, v_rel: float, model: str, k_h: float = ..., k_r: float = ..., k: float = ...
 ) -> float:
-    """Maximum impact force (N) for effective mass m_star (kg) at v_rel (m/s)."""
+    """Maximum impact force (N) for effective mass m_star (kg) at v_rel (m/s) under law
+    ``model`` (as :func:`demfem.contact.max_contact_force`, which takes two bodies)."""
 
 def tsuji_restitution(zeta: float, clamp: bool = False) -> float:
     """Restitution of a Hertz impact with Tsuji damping parameter zeta (dimensionless)."""
@@ -49,11 +52,13 @@ def tsuji_restitution(zeta: float, clamp: bool = False) -> float:
 def tsuji_damping_for_restitution(e: float, clamp: bool = False) -> float:
     """Tsuji damping parameter zeta that realises restitution e in (0, 1]."""
 
-def rayleigh_time_step(radius: float, density: float, e: float, nu: float) -> float:
-    """Rayleigh time step (s) of a sphere: radius (m), density (kg/m^3), E (Pa), nu."""
+def rayleigh_time_step(radius: float, E: float, nu: float, density: float) -> float:
+    """Rayleigh time step (s) of a sphere: radius (m), E (Pa), nu, density (kg/m^3), as
+    :func:`demfem.contact.rayleigh_time_step`."""
 
-def hertz_contact_duration(k_h: float, m_star: float, v_rel: float) -> float:
-    """Duration (s) of an undamped Hertz impact: k_h (N/m^1.5), m_star (kg), v_rel (m/s)."""
+def hertz_impact_duration(k_h: float, m_star: float, v_rel: float) -> float:
+    """Duration (s) of an undamped Hertz impact: k_h (N/m^1.5), m_star (kg), v_rel (m/s)
+    (:func:`demfem.contact.hertz_contact_duration` takes the two bodies instead)."""
 
 @final
 class DemSimulation:
@@ -68,21 +73,23 @@ class DemSimulation:
     effects: names from gravity, belt, moving_walls, friction, rotation, damping,
     rolling_resistance, planar. gravity (m/s^2) defaults to (0, 0, -9.81). dt (s) defaults
     to dt_safety x the stable limit; a larger one
-    raises UnstableTimeStepError.
+    raises UnstableTimeStepError, and one above 1 s (possible only without particles)
+    InvalidParameterError. Arrays of any real (integer) dtype are converted; other input
+    raises InvalidParameterError naming the field; negative counts likewise.
     """
 
     def __new__(
         cls,
-        positions: npt.NDArray[np.float64],
-        radii: npt.NDArray[np.float64],
+        positions: npt.ArrayLike,
+        radii: npt.ArrayLike,
         materials: list[dict[str, float]],
         walls: list[dict[str, Any]],
         effects: Sequence[str],
         *,
-        velocities: Optional[npt.NDArray[np.float64]] = None,
-        angular_velocities: Optional[npt.NDArray[np.float64]] = None,
-        material_ids: Optional[npt.NDArray[np.int64]] = None,
-        tags: Optional[npt.NDArray[np.int64]] = None,
+        velocities: Optional[npt.ArrayLike] = None,
+        angular_velocities: Optional[npt.ArrayLike] = None,
+        material_ids: Optional[npt.ArrayLike] = None,
+        tags: Optional[npt.ArrayLike] = None,
         gravity: tuple[float, float, float] = ...,
         model: str = "hertz_mindlin",
         linear_stiffness: Optional[tuple[float, float]] = None,
@@ -111,7 +118,10 @@ class DemSimulation:
         """The anchor table of shared/anchors/dem/scene.py at E (Pa); start 'square' or
         'packed'; initial_vx (m/s) for every sphere."""
     def step(self, n: int, chunk: int = 2000) -> None:
-        """Advance n steps (GIL released per chunk; Ctrl-C raises SimulationInterrupted)."""
+        """Advance n steps; the GIL is released in slices of about 0.1 s of wall time
+        whatever ``chunk`` is, so Ctrl-C raises SimulationInterrupted within a fraction of a
+        second. Negative n or chunk, or n steps that would make the time infinite, raise
+        InvalidParameterError."""
     def run_until(self, t_end: float, chunk: int = 2000) -> int:
         """Advance to simulated time t_end (s); returns the steps taken."""
     @property

@@ -4,13 +4,40 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-from typing import Optional, Sequence
+from typing import NoReturn, Optional, Sequence
 
 import numpy as np
 
-from demfem.errors import DemfemError, InvalidParameterError
+from demfem.errors import (CheckpointError, DemfemError, InvalidParameterError,
+                           SettingsMismatchError, SimulationInterrupted)
 
-__all__ = ["main", "build_parser", "study_options_from_args"]
+__all__ = ["main", "build_parser", "study_options_from_args", "package_version"]
+
+
+def package_version() -> str:
+    """The installed package's version (importlib.metadata), else ``demfem.__version__``."""
+    try:
+        from importlib.metadata import PackageNotFoundError, version
+
+        return version("demfem")
+    except (ImportError, PackageNotFoundError):
+        import demfem
+
+        return str(demfem.__version__)
+
+
+class _Parser(argparse.ArgumentParser):
+    """Bad arguments: one line ``demfem: error: ...`` on standard error, exit code 2."""
+
+    def error(self, message: str) -> "NoReturn":  # type: ignore[override]
+        sys.stderr.write(f"demfem: error: {message} (see '{self.prog} --help')\n")
+        raise SystemExit(2)
+
+
+def _add_modulus(parser: argparse.ArgumentParser, help_text: str, **kwargs) -> None:
+    """``--E`` (documented) and ``--young-modulus`` (the same option), one destination."""
+    parser.add_argument("--E", "--young-modulus", dest="young_modulus", help=help_text,
+                        **kwargs)
 
 
 def _cmd_calibrate(args: argparse.Namespace) -> int:
@@ -35,7 +62,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
         0.01 if args.quick else 0.02, duration)
     run_pipeline(args.out, duration=duration, young_modulus=args.young_modulus,
                  sample_interval=sample, threads=args.threads, progress=True,
-                 log=lambda line: print(line, flush=True))
+                 log=lambda line: print(line, flush=True), scene=args.scene,
+                 fresh=args.fresh)
     return 0
 
 
@@ -74,7 +102,7 @@ def study_options_from_args(args: argparse.Namespace):
     if args.quick:
         duration, moduli = q_duration, q_moduli
     duration = args.duration if args.duration is not None else duration
-    text = args.E if args.E is not None else moduli
+    text = args.young_modulus if args.young_modulus is not None else moduli
     try:
         values = tuple(float(x) for x in text.split(","))
     except ValueError:
@@ -129,8 +157,8 @@ def _add_study(sub, name: str, help_text: str) -> argparse.ArgumentParser:
     s = sub.add_parser(name, help=help_text)
     s.add_argument("--duration", type=float, default=None,
                    help=f"simulated time per run, s ({duration:g}; --quick: {q_duration:g})")
-    s.add_argument("--E", default=None, metavar="E1,E2,...",
-                   help=f"Young's modulus/moduli, Pa ({moduli})")
+    _add_modulus(s, f"Young's modulus/moduli, Pa ({moduli})", default=None,
+                 metavar="E1,E2,...")
     s.add_argument("--quick", action="store_true",
                    help="a smoke run (0.3 s simulated per run) with the same outputs")
     s.add_argument("--sample-interval", type=float, default=None,
@@ -147,7 +175,11 @@ def _add_study(sub, name: str, help_text: str) -> argparse.ArgumentParser:
 def _cmd_equivalence(args: argparse.Namespace) -> int:
     from demfem.equivalence import StudyConfig, run_study
 
-    config = StudyConfig(n_spheres=args.n, young_modulus=args.young_modulus, t_end=args.t_end)
+    from demfem.errors import check_positive
+
+    check_positive("duration", args.duration)
+    config = StudyConfig(n_spheres=args.n, young_modulus=args.young_modulus,
+                         t_end=args.duration)
     result = run_study(config, args.out, progress=lambda msg: print("  " + msg, flush=True))
     print(result["markdown"], end="")
     print(f"written: {args.out}/equivalence.csv, .md, .png")
@@ -156,9 +188,10 @@ def _cmd_equivalence(args: argparse.Namespace) -> int:
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``demfem`` command."""
-    p = argparse.ArgumentParser(prog="demfem", description="DEM-FEM breakage of glass cartridges "
-                                "on a conveyor-belt accumulation table (SI units).")
-    sub = p.add_subparsers(dest="command", required=True)
+    p = _Parser(prog="demfem", description="DEM-FEM breakage of glass cartridges on a "
+                "conveyor-belt accumulation table (SI units).")
+    p.add_argument("--version", action="version", version=f"demfem {package_version()}")
+    sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
     c = sub.add_parser("calibrate", help="equivalent sphere and Fig. 3: max force vs E per law")
     c.add_argument("--v-rel", type=float, default=0.2, help="relative impact speed, m/s (0.2)")
     c.add_argument("--e-min", type=float, default=1e7, help="smallest Young's modulus, Pa (1e7)")
@@ -166,11 +199,14 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--n", type=int, default=9, help="number of moduli, log-spaced (9)")
     c.add_argument("--out", default="demfem_out", help="output directory (demfem_out)")
     c.set_defaults(func=_cmd_calibrate)
-    r = sub.add_parser("run", help="the main job: calibration, DEM of the default table, analysis")
+    r = sub.add_parser("run", help="the main job: calibration, DEM of a table scene, analysis")
+    r.add_argument("scene", nargs="?", default=None, metavar="SCENE.toml",
+                   help="table scene file (see examples/table_default.toml; default: the "
+                        "built-in default table)")
     r.add_argument("--duration", type=float, default=None,
                    help="simulated time of the table, s (1.0; --quick: 0.1)")
-    r.add_argument("--E", dest="young_modulus", type=float, default=None,
-                   help="Young's modulus of the glass, Pa (the paper's 4.5e10)")
+    _add_modulus(r, "Young's modulus of the glass, Pa (default: the scene's; built-in "
+                 "default: the paper's 4.5e10)", type=float, default=None)
     r.add_argument("--sample-interval", type=float, default=None,
                    help="time between recorded samples, s (0.02; --quick: 0.01)")
     r.add_argument("--threads", type=int, default=min(2, os.cpu_count() or 1),
@@ -178,7 +214,9 @@ def build_parser() -> argparse.ArgumentParser:
                         "are bitwise the same on any number)")
     r.add_argument("--quick", action="store_true", help="a smoke run with the same outputs")
     r.add_argument("--out", default="demfem_out/run", help="output directory (demfem_out/run); "
-                   "an interrupted run resumes from its checkpoint there")
+                   "the same run there resumes from its checkpoint, another one is refused")
+    r.add_argument("--fresh", "--overwrite", dest="fresh", action="store_true",
+                   help="replace the run in --out (its outputs and checkpoint are removed)")
     r.set_defaults(func=_cmd_run)
     s = sub.add_parser("sweep", help="run a parameter grid on Dask (LocalCluster by default)")
     s.add_argument("--runner", required=True,
@@ -210,21 +248,44 @@ def build_parser() -> argparse.ArgumentParser:
                     help="times of the table snapshots, s (9.3,12.2; clipped to the run)")
     e = sub.add_parser("equivalence", help="spheres vs clumped vs exact cartridges on one table")
     e.add_argument("--n", type=int, default=40, help="bodies on the reduced table (40)")
-    e.add_argument("--young-modulus", type=float, default=45e7, help="Young's modulus, Pa (4.5e8)")
-    e.add_argument("--t-end", type=float, default=2.0, help="simulated time, s (2.0)")
+    _add_modulus(e, "Young's modulus, Pa (4.5e8)", type=float, default=45e7)
+    e.add_argument("--duration", "--t-end", dest="duration", type=float, default=2.0,
+                   help="simulated time, s (2.0)")
     e.add_argument("--out", default="demfem_out/equivalence", help="output directory")
     e.set_defaults(func=_cmd_equivalence)
     return p
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
-    """Entry point of the ``demfem`` command; returns the exit code."""
-    args = build_parser().parse_args(argv)
+    """Entry point of the ``demfem`` command; returns the exit code: 0 done, 1 a failed run
+    (a numerical failure, a damaged file, an i/o error), 2 bad arguments or settings, 130
+    interrupted. Errors are one line ``demfem: error: ...`` on standard error, never a
+    traceback."""
+    try:
+        args = build_parser().parse_args(argv)
+    except SystemExit as exc:  # --help, --version, or a bad argument (already reported)
+        return int(exc.code or 0) if not isinstance(exc.code, str) else 2
+    fresh_hint = " (to start afresh: demfem run ... --fresh)" if args.command == "run" else ""
     try:
         return int(args.func(args))
-    except (DemfemError, ValueError) as exc:
-        print(f"demfem {args.command}: error: {exc}", file=sys.stderr)
+    except SimulationInterrupted as exc:
+        print(f"demfem: interrupted: {exc}", file=sys.stderr)
+        return 130
+    except KeyboardInterrupt:
+        print("demfem: interrupted", file=sys.stderr)
+        return 130
+    except CheckpointError as exc:
+        print(f"demfem: error: {exc}{fresh_hint}", file=sys.stderr)
+        return 1
+    except SettingsMismatchError as exc:
+        print(f"demfem: error: {exc}", file=sys.stderr)
         return 2
+    except (InvalidParameterError, ValueError) as exc:
+        print(f"demfem: error: {exc}", file=sys.stderr)
+        return 2
+    except (DemfemError, OSError) as exc:
+        print(f"demfem: error: {exc}", file=sys.stderr)
+        return 1
 
 
 if __name__ == "__main__":  # pragma: no cover

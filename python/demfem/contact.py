@@ -211,8 +211,19 @@ def _pair(a: ContactBody, b: ContactBody) -> tuple[float, float, float]:
     return 4.0 / 3.0 * math.sqrt(r_star) * e_star, k_r, m_star
 
 
-def _check_v(v_rel: float) -> float:
-    return check_range("v_rel", v_rel, 0.0, math.inf, lo_open=False)
+#: Smallest non-zero relative impact speed, m/s: below it m* v_rel^2 can underflow to zero
+#: (a ZeroDivisionError otherwise) and overlaps would be below 1e-20 m, far under any
+#: physical length.
+V_REL_MIN = 1e-12
+
+
+def _check_v(v_rel: float, allow_zero: bool = True) -> float:
+    v = check_range("v_rel", v_rel, 0.0, math.inf, lo_open=False)
+    if (v == 0.0 and not allow_zero) or 0.0 < v < V_REL_MIN:
+        raise InvalidParameterError(
+            f"invalid v_rel = {v_rel!r}: must be {'0 or ' if allow_zero else ''}in "
+            f"[{V_REL_MIN:g}, inf) m/s")
+    return v
 
 
 def k_linear(a: ContactBody, b: ContactBody, v_rel: float) -> float:
@@ -320,7 +331,7 @@ def hertz_max_overlap(a: ContactBody, b: ContactBody, v_rel: float) -> float:
 def hertz_contact_duration(a: ContactBody, b: ContactBody, v_rel: float) -> float:
     """Duration of an undamped Hertz impact, s:
     t_c = 2 (δ_max / v) ∫₀¹ (1 − x^{5/2})^{-1/2} dx = 2.9432… δ_max / v (Johnson §11.4)."""
-    v = check_positive("v_rel", v_rel)
+    v = _check_v(v_rel, allow_zero=False)
     from scipy.special import beta
 
     factor = 2.0 * 0.4 * beta(0.4, 0.5)
@@ -421,7 +432,7 @@ def damped_hertz_impact(a: ContactBody, b: ContactBody, v_rel: float, restitutio
                         clamp: bool = False, n_out: int = 400) -> ImpactResult:
     """Integrate one head-on Hertz impact (dimensional units) with Tsuji damping chosen for
     ``restitution``; ``v_rel`` in m/s. Returns the histories and the realised restitution."""
-    v = check_positive("v_rel", v_rel)
+    v = _check_v(v_rel, allow_zero=False)
     k_h, _, m_star = _pair(a, b)
     zeta = tsuji_damping_for_restitution(restitution, clamp)
     c = zeta * math.sqrt(m_star * k_h)

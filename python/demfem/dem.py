@@ -35,6 +35,7 @@ __all__ = [
     "from_scene",
     "refeed_removed",
     "scene_walls",
+    "check_state",
     "CONTACT_MODELS",
 ]
 
@@ -316,3 +317,56 @@ def scene_walls(scene: Any, material_index: Callable[[str], int]) -> list[dict[s
             raise InvalidParameterError(f"invalid wall {w.get('name')!r} kind = {w['kind']!r}: "
                                         "must be 'plane' or 'polygon'")
     return walls
+
+
+def check_state(sim: DemSimulation, *, floor: Optional[tuple[Any, Any]] = None,
+                overlap_fraction: float = 0.1) -> None:
+    """Physical sanity check of a running simulation; raises
+    :class:`demfem.errors.NumericalError` naming the sphere, the depth and the likely cause.
+
+    * every alive sphere's centre and velocity must be finite;
+    * ``floor``: (point (m), normal) of a plane that holds the spheres (the belt): no sphere
+      may sink into it deeper than ``overlap_fraction`` of its radius;
+    * the deepest contact overlap (:meth:`DemSimulation.max_overlap`, m) must stay below
+      ``overlap_fraction`` of the smallest radius.
+
+    Deep overlaps mean the contact stiffness is too low for the load (Young's modulus too
+    low) or the time step too large; the results of such a run are not physical.
+    """
+    import numpy as np
+
+    from demfem.errors import NumericalError, check_range
+
+    frac = check_range("overlap_fraction", overlap_fraction, 0.0, 1.0, hi_open=False)
+    alive = np.asarray(sim.alive(), bool)
+    if not alive.any():
+        return
+    pos = np.asarray(sim.positions(), float)[alive]
+    radii = np.asarray(sim.radii(), float)[alive]
+    index = np.flatnonzero(alive)
+    cause = ("the contact stiffness is too low for the load (Young's modulus too low) or "
+             "the time step too large")
+    bad = ~np.all(np.isfinite(pos), axis=1) | ~np.all(
+        np.isfinite(np.asarray(sim.velocities(), float)[alive]), axis=1)
+    if bad.any():
+        i = int(index[np.argmax(bad)])
+        raise NumericalError(f"sphere {i} has a non-finite position or velocity at "
+                             f"t = {sim.time:.6g} s: the simulation lost stability ({cause})")
+    if floor is not None:
+        point = np.asarray(floor[0], float)
+        normal = np.asarray(floor[1], float)
+        normal = normal / np.linalg.norm(normal)
+        depth = radii - (pos - point) @ normal  # penetration into the floor, m
+        worst = int(np.argmax(depth / radii))
+        if depth[worst] > frac * radii[worst]:
+            below = int(np.count_nonzero(depth > frac * radii))
+            raise NumericalError(
+                f"sphere {int(index[worst])} has sunk {depth[worst]:.3g} m into the belt "
+                f"(limit {frac:g} x radius = {frac * radii[worst]:.3g} m) at "
+                f"t = {sim.time:.6g} s, {below} sphere(s) in all: {cause}")
+    overlap = float(sim.max_overlap())
+    limit = frac * float(radii.min())
+    if not np.isfinite(overlap) or overlap > limit:
+        raise NumericalError(
+            f"max_overlap = {overlap:.3g} m exceeds {frac:g} x the sphere radius "
+            f"({limit:.3g} m) at t = {sim.time:.6g} s: {cause}")

@@ -60,6 +60,23 @@ class StudyConfig:
     tilt_threshold_deg: float = 5.0
     fallen_threshold_deg: float = 60.0
 
+    def __post_init__(self) -> None:
+        from demfem.errors import check_count, check_positive, check_range
+
+        check_count("n_spheres", self.n_spheres, 1)
+        for name in ("length", "width", "tilted_wall_length", "opening_width", "gate_period",
+                     "wall_height", "young_modulus", "t_end", "sample_every"):
+            check_positive(name, getattr(self, name))
+        check_range("gate_amplitude", self.gate_amplitude, 0.0, lo_open=False)
+        check_range("t_settle", self.t_settle, 0.0, lo_open=False)
+        if self.sample_every > self.t_end:
+            from demfem.errors import InvalidParameterError
+
+            raise InvalidParameterError(f"invalid sample_every = {self.sample_every!r}: must "
+                                        f"not exceed t_end = {self.t_end!r} s")
+        for name in ("tilt_threshold_deg", "fallen_threshold_deg"):
+            check_range(name, getattr(self, name), 0.0, 90.0)
+
     def table(self, particle: str) -> AccumulationTable:
         """The table with ``particle`` at the start sites."""
         return AccumulationTable(

@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+import numpy as np
 
 
 class DemfemError(Exception):
@@ -41,6 +42,16 @@ class DemfemIOError(DemfemError, OSError):
     """Reading or writing a file failed."""
 
 
+class CheckpointError(DemfemIOError):
+    """A checkpoint or record file that is damaged (truncated, altered: its checksum does
+    not match) or unreadable; the message names the file."""
+
+
+class SettingsMismatchError(DemfemError, ValueError):
+    """A run asked to resume from a checkpoint or an output folder made with other settings;
+    the message names each setting that differs."""
+
+
 class SimulationInterrupted(DemfemError, KeyboardInterrupt):
     """A run stopped cleanly at a step boundary (Ctrl-C); its state is consistent and can be
     checkpointed or continued."""
@@ -57,10 +68,17 @@ __all__ = [
     "UnstableTimeStepError",
     "check_range",
     "check_positive",
+    "check_count",
+    "CheckpointError",
+    "SettingsMismatchError",
 ]
 
 
 def _as_float(field: str, value: Any) -> float:
+    # True would be taken as 1.0: a boolean is never a physical quantity
+    if isinstance(value, (bool, np.bool_)):
+        raise InvalidParameterError(f"invalid {field} = {value!r}: must be a real number, "
+                                    "not a boolean")
     try:
         x = float(value)
     except (TypeError, ValueError):
@@ -94,3 +112,15 @@ def check_range(
 def check_positive(field: str, value: Any) -> float:
     """``value`` as a float if finite and > 0, else :class:`InvalidParameterError`."""
     return check_range(field, value, 0.0, math.inf)
+
+
+def check_count(field: str, value: Any, lo: int = 0) -> int:
+    """``value`` as an int if it is a whole number >= ``lo`` (booleans and non-integral
+    floats refused), else :class:`InvalidParameterError` naming ``field``."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        raise InvalidParameterError(f"invalid {field} = {value!r}: must be a whole number "
+                                    f">= {lo}")
+    if value < lo:
+        raise InvalidParameterError(f"invalid {field} = {value!r}: must be a whole number "
+                                    f">= {lo}")
+    return int(value)

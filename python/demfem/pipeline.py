@@ -5,10 +5,11 @@
 1. **Calibration** of the equivalent sphere of the default 3 mL cartridge: mass, diameter,
    Reissner shell stiffness, Hertz contact time, Rayleigh step, and the Fig. 3 analogue (the
    maximum force of two colliding cartridges against E, for each contact law).
-2. **DEM** of the default accumulation table (840 equivalent spheres of that cartridge, E =
-   45 GPa, belt 0.2 m/s into the funnel, gate A = 2 cm, T = 2 s), recorded every
+2. **DEM** of the accumulation table (the built-in default: 840 equivalent spheres of that
+   cartridge, E = 45 GPa, belt 0.2 m/s into the funnel, gate A = 2 cm, T = 2 s; or a user's
+   scene, an :class:`~demfem.scenes.AccumulationTable` or its TOML file), recorded every
    ``sample_interval`` s, with every sphere-sphere contact onset logged. The run checkpoints
-   into the output folder and resumes from it when started again with the same arguments.
+   into the output folder and resumes from it when started again with the same settings.
 3. **Analysis**: first-line force, coordination numbers, speeds of the tagged spheres,
    collision statistics (impact speeds and angles at contact onset), spheres that left
    through the opening.
@@ -19,12 +20,20 @@ not in demfem yet; the report says so instead of inventing numbers.
 Outputs in ``out``: ``calibration.csv`` and ``calibration_force_vs_E.png``, ``table_run.npz``
 (the whole record, :class:`demfem.studies.table_run.TableRun`), ``collisions.csv`` (one row
 per contact onset), ``summary.json``, ``table_time_series.png``, ``collisions.png``,
-``table_end.png`` and a ParaView series ``vtk/table.pvd``. Every file is written atomically.
+``table_end.png``, a ParaView series ``vtk/table.pvd`` and ``run.json`` (the run's settings:
+the scene's TOML text and SHA-256, duration, sample interval, E, ...). Every file is written
+atomically; JSON files are strict (no NaN: null).
+
+An output folder that holds another run is refused (:class:`~demfem.errors.
+SettingsMismatchError` naming the settings that differ) unless ``fresh=True``, which removes
+the old run's outputs first; one that holds the same run resumes it.
 
 SI units throughout: m, s, kg, N, Pa.
 """
 from __future__ import annotations
 
+import dataclasses
+import hashlib
 import json
 import math
 from pathlib import Path
@@ -32,13 +41,106 @@ from typing import Any, Callable, Optional
 
 import numpy as np
 
-from demfem.errors import SimulationInterrupted, check_positive, check_range
+from demfem.errors import (CheckpointError, SettingsMismatchError, SimulationInterrupted,
+                           check_positive, check_range)
 
-__all__ = ["run_pipeline", "NOT_YET"]
+__all__ = ["run_pipeline", "load_scene", "NOT_YET", "OUTPUT_FILES"]
 
 #: The paper's stages demfem does not run yet (printed by the report, kept in the summary).
 NOT_YET = ("FEM of the seven-cartridge cluster (stage 4)",
            "breakage probability per cartridge from the DEM collisions (stage 5)")
+
+#: Files a run writes into its output folder (besides the ``vtk/`` series): removed by a
+#: fresh start so that no old output stays beside the new ones.
+OUTPUT_FILES = ("calibration.csv", "calibration_force_vs_E.png", "table_run.npz",
+                "collisions.csv", "collisions.png", "summary.json", "table_time_series.png",
+                "table_end.png", "run.json")
+_CHECKPOINT = "table.ck"
+_RUN_RECORD = "run.json"
+
+
+def load_scene(scene: Any = None):
+    """The :class:`~demfem.scenes.AccumulationTable` of ``scene``: None (the built-in
+    default), a table, or the path of a TOML scene file (``AccumulationTable.to_toml``)."""
+    from demfem.errors import InvalidParameterError
+    from demfem.scenes.table import AccumulationTable
+
+    if scene is None:
+        return AccumulationTable()
+    if isinstance(scene, AccumulationTable):
+        return scene
+    if isinstance(scene, (str, Path)):
+        return AccumulationTable.from_toml(scene)
+    raise InvalidParameterError(f"invalid scene = {scene!r}: must be None, an "
+                                "AccumulationTable or the path of a TOML scene file")
+
+
+def _settings(table, duration: float, sample_interval: float, v_rel: float,
+              discard: float, model: str) -> dict[str, Any]:
+    toml = table.toml_text()
+    return {"scene_sha256": hashlib.sha256(toml.encode("utf-8")).hexdigest(),
+            "scene_toml": toml, "duration_s": float(duration),
+            "sample_interval_s": float(sample_interval),
+            "young_modulus_Pa": float(table.young_modulus), "v_rel_m_per_s": float(v_rel),
+            "statistics_from_s": float(discard), "model": model}
+
+
+def _clear_outputs(out: Path) -> None:
+    """Remove a previous run's outputs (and only those) from ``out``."""
+    from demfem.studies.table_run import remove_checkpoint
+
+    for name in OUTPUT_FILES:
+        (out / name).unlink(missing_ok=True)
+    remove_checkpoint(out / _CHECKPOINT)
+    vtk = out / "vtk"
+    if vtk.is_dir():
+        for p in (*vtk.glob("table_*.vtp"), vtk / "table.pvd"):
+            p.unlink(missing_ok=True)
+        if not any(vtk.iterdir()):
+            vtk.rmdir()
+
+
+def _prepare_folder(out: Path, settings: dict[str, Any], fresh: bool) -> Optional[dict]:
+    """Check ``out`` against this run's settings; returns the previous run's record when it
+    is the same run (to resume or reuse), else None after clearing the old outputs (fresh)
+    or refusing them."""
+    from demfem.io.atomic import clean_stale_temporaries
+    from demfem.studies.table_run import settings_differences
+
+    clean_stale_temporaries(out)
+    record_path = out / _RUN_RECORD
+    previous = None
+    if record_path.exists():
+        try:
+            previous = json.loads(record_path.read_text(encoding="utf-8"))
+            if not isinstance(previous, dict) or "settings" not in previous:
+                raise ValueError("no 'settings'")
+        except (OSError, UnicodeDecodeError, ValueError) as exc:
+            if not fresh:
+                raise CheckpointError(f"damaged run record {record_path}: {exc}; start "
+                                      "afresh (fresh=True, demfem run --fresh)") from None
+            previous = None
+    elif not fresh and any((out / n).exists() for n in
+                           ("summary.json", "table_run.npz", _CHECKPOINT, "vtk")):
+        raise SettingsMismatchError(
+            f"the output folder {out} holds another run (without a run record {_RUN_RECORD}"
+            "): choose another output folder, or replace it (fresh=True, demfem run "
+            "--fresh)")
+    if previous is not None and not fresh:
+        old = dict(previous["settings"])
+        diff = settings_differences({k: v for k, v in old.items() if k != "scene_toml"},
+                                    {k: v for k, v in settings.items() if k != "scene_toml"})
+        if diff:
+            raise SettingsMismatchError(
+                f"the output folder {out} holds a run with other settings ("
+                + "; ".join(d if not d.startswith("scene_sha256") else
+                            "scene: another scene file or other scene values"
+                            for d in diff)
+                + "): use the same settings to resume it, another output folder, or "
+                "replace it (fresh=True, demfem run --fresh)")
+        return previous
+    _clear_outputs(out)
+    return None
 
 
 def run_pipeline(out: str | Path = "demfem_out/run", duration: float = 1.0,
@@ -46,48 +148,59 @@ def run_pipeline(out: str | Path = "demfem_out/run", duration: float = 1.0,
                  threads: int = 1, v_rel: float = 0.2, discard_before: Optional[float] = None,
                  checkpoint_every: float = 15.0,
                  log: Callable[[str], None] = print,
-                 progress: bool | Callable[[float, int], None] = False) -> dict[str, Any]:
-    """Run calibration, the DEM of the default table and its analysis; write the outputs.
+                 progress: bool | Callable[[float, int], None] = False,
+                 scene: Any = None, fresh: bool = False) -> dict[str, Any]:
+    """Run calibration, the DEM of the table and its analysis; write the outputs.
 
     Args:
         out: output folder (created).
         duration: simulated time of the table run, s.
-        young_modulus: Young's modulus of the glass, Pa (default: the paper's 45 GPa).
+        young_modulus: Young's modulus of the glass, Pa (default: the scene's; the default
+            scene has the paper's 45 GPa).
         sample_interval: time between recorded samples, s.
         threads: DEM engine threads (results are bitwise the same on any number).
         v_rel: relative impact speed of the calibration's two cartridges, m/s.
         discard_before: start of the force and coordination statistics, s (default: half
             the run, after the pack has begun to form).
         checkpoint_every: wall time between checkpoints of the table run, s. An interrupted
-            job (Ctrl-C) started again with the same arguments resumes from the last one.
+            job (Ctrl-C) started again with the same settings resumes from the last one.
         log: where the report's lines go.
         progress: callback ``progress(sim_time_s, steps)`` of the table run, or ``True`` for
             a :class:`demfem.progress.ProgressBar` on standard error started with the run.
+        scene: the table: None (built-in default), an
+            :class:`~demfem.scenes.AccumulationTable`, or the path of its TOML file.
+        fresh: replace a run with other settings in ``out`` (its outputs are removed) and
+            ignore any checkpoint, instead of refusing it / resuming.
 
     Returns:
         The summary (also written to ``summary.json``): calibration, the run's numbers,
         collision statistics and the output paths.
     """
-    from demfem.analysis.collisions import onset_histogram, onset_quantiles
-    from demfem.analysis.kinematics import tagged_speed
     from demfem.calibration import calibration_report, force_vs_modulus, write_calibration
     from demfem.cartridge import Cartridge
-    from demfem.io.atomic import savefig_atomic, write_text_atomic
-    from demfem.plots import plot_table_snapshot
+    from demfem.io.strict_json import write_json_atomic
     from demfem.progress import ProgressBar
-    from demfem.scenes.table import AccumulationTable, Tag
-    from demfem.studies.figures import _write_vtk_series
-    from demfem.studies.table_run import _check_run_arguments, _checkpoint_files, run_table
+    from demfem.studies.table_run import (TableRun, check_run_arguments, checkpoint_state,
+                                          run_table, sha256_file)
 
     # every argument checked before any work
-    _check_run_arguments(duration, sample_interval, threads)
+    check_run_arguments(duration, sample_interval, threads)
     v_rel = check_positive("v_rel", v_rel)
     discard = 0.5 * duration if discard_before is None else check_range(
         "discard_before", discard_before, hi=duration, hi_open=False)
-    table = AccumulationTable() if young_modulus is None else AccumulationTable(
-        young_modulus=young_modulus)
+    table = load_scene(scene)
+    if young_modulus is not None:
+        table = dataclasses.replace(table, young_modulus=check_positive("young_modulus",
+                                                                         young_modulus))
+    model = "hertz_reissner_mindlin"
+    settings = _settings(table, duration, sample_interval, v_rel, discard, model)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
+    previous = _prepare_folder(out, settings, fresh)
+    record_path = out / _RUN_RECORD
+    record = {"format": 1, "status": "running", "settings": settings}
+    if previous is None or previous.get("status") != "complete":
+        write_json_atomic(record_path, record)
 
     # 1. calibration
     log("== 1. calibration: the equivalent sphere ==")
@@ -100,130 +213,58 @@ def run_pipeline(out: str | Path = "demfem_out/run", duration: float = 1.0,
     # 2. DEM of the table
     log(f"\n== 2. DEM: the accumulation table, {table.n_spheres} spheres, "
         f"E = {table.young_modulus:.3g} Pa, {duration:g} s ==")
-    bar = ProgressBar(duration, label="table") if progress is True else None
-    callback = bar if bar is not None else (progress if callable(progress) else None)
-    checkpoint = out / "table.ck"
-    try:
+    run_path = out / "table_run.npz"
+    checkpoint = out / _CHECKPOINT
+    run = None
+    if previous is not None and previous.get("status") == "complete" and run_path.exists():
+        if sha256_file(run_path) != previous.get("table_run_sha256"):
+            raise CheckpointError(f"damaged run file {run_path}: its SHA-256 differs from the "
+                                  f"one in {record_path}; start afresh (fresh=True, demfem "
+                                  "run --fresh)")
+        run = TableRun.load(run_path)
+        log(f"  the same run is complete in {out}: its record is reused")
+    if run is None:
+        bar = ProgressBar(duration, label="table") if progress is True else None
+        callback = bar if bar is not None else (progress if callable(progress) else None)
         try:
-            run = run_table(table, duration, sample_interval, threads=threads,
-                            progress=callback, checkpoint=checkpoint,
-                            checkpoint_every=checkpoint_every)
-        finally:
-            if bar is not None:
-                bar.close()
-    except SimulationInterrupted:
-        saved = _checkpoint_files(checkpoint)[2]  # its wall and simulated time
-        if saved.exists() and "sim_time_s" in (state := json.loads(saved.read_text())):
-            log(f"interrupted: started again with the same arguments, the job resumes from "
-                f"its checkpoint at t = {state['sim_time_s']:.4g} s ({checkpoint})")
-        else:
-            log(f"interrupted before the first checkpoint (every {checkpoint_every:g} s of "
-                "wall time): nothing to resume")
-        raise
-    run_path = run.save(out / "table_run.npz")
+            try:
+                run = run_table(table, duration, sample_interval, threads=threads, model=model,
+                                progress=callback, checkpoint=checkpoint,
+                                checkpoint_every=checkpoint_every, fresh=fresh)
+            finally:
+                if bar is not None:
+                    bar.close()
+        except SimulationInterrupted:
+            state = checkpoint_state(checkpoint)
+            if state is not None:
+                log(f"interrupted: started again with the same settings, the job resumes "
+                    f"from its checkpoint at t = {state['sim_time_s']:.4g} s ({checkpoint})")
+            else:
+                log(f"interrupted before the first checkpoint (every {checkpoint_every:g} s "
+                    "of wall time): nothing to resume")
+            raise
+        run.save(run_path)
     info = run.info
     log(f"  {info['steps']} steps of {info['dt']:.3g} s in {info['wall_time_s']:.1f} s wall "
         f"({table.n_spheres * info['steps'] / max(info['wall_time_s'], 1e-9):.3g} "
         f"particle-steps/s), effects: {', '.join(info['effects'])}")
 
-    # 3. analysis
-    log("\n== 3. analysis ==")
-    summary = run.summary(discard_before=discard)
-    onsets = run.onsets
-    q = (0.5, 0.9, 0.99, 1.0)
-    collisions = {
-        "n_onsets": int(len(onsets)),
-        "onsets_per_s": float(len(onsets) / duration),
-        "quantiles": list(q),
-        "normal_speed_m_s": onset_quantiles(onsets, "normal_speed", q).tolist(),
-        "tangential_speed_m_s": onset_quantiles(onsets, "tangential_speed", q).tolist(),
-        "impact_angle_deg": np.degrees(onset_quantiles(onsets, "impact_angle", q)).tolist(),
-    }
-    speeds = {name: tagged_speed(run.velocities, run.tags, tag)
-              for name, tag in (("triangular_centre", Tag.TRIANGULAR_CENTRE),
-                                ("rectangular_centre", Tag.RECTANGULAR_CENTRE),
-                                ("first_line", Tag.FIRST_LINE))}
-    keep = run.times >= discard
-    tagged = {f"{name}_mean_speed_mm_s": float(1e3 * np.nanmean(s[keep])) if np.isfinite(
-        s[keep]).any() else math.nan for name, s in speeds.items()}
-    log(f"  statistics from t = {discard:g} s on")
-    log(f"  first-line force: mean {summary['force_mean_N']:.4g} N, 95 % "
-        f"{summary['force_q95_N']:.4g} N, peak {summary['force_peak_N']:.4g} N "
-        f"(in the plane: mean {summary['in_plane_force_mean_N']:.4g} N)")
-    log(f"  mean coordination {summary['coordination_mean']:.3f}; spheres out through the "
-        f"opening {summary['n_removed']}; riding up at the end {summary['riding_up_end']}; "
-        f"largest overlap {summary['max_overlap_m']:.3g} m")
-    for name in speeds:
-        log(f"  {name.replace('_', ' ')}: mean speed {tagged[f'{name}_mean_speed_mm_s']:.3g} mm/s")
-    log(f"  collisions: {collisions['n_onsets']} contact onsets "
-        f"({collisions['onsets_per_s']:.3g} per s); normal impact speed median / 90 % / "
-        f"99 % / max " + " / ".join(f"{1e3 * v:.3g}" for v in collisions["normal_speed_m_s"])
-        + " mm/s")
+    # 3. analysis and figures
+    from demfem.studies.run_report import write_analysis
 
-    csv_lines = ["i,j,time_s,normal_speed_m_s,tangential_speed_m_s,impact_angle_rad,"
-                 "coordination_i,coordination_j"]
-    csv_lines += [f"{r['i']},{r['j']},{r['time']:.9g},{r['normal_speed']:.9g},"
-                  f"{r['tangential_speed']:.9g},{r['impact_angle']:.9g},"
-                  f"{r['coordination_i']},{r['coordination_j']}" for r in onsets]
-    coll_csv = write_text_atomic(out / "collisions.csv", "\n".join(csv_lines) + "\n")
-
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    t = run.times
-    fig, axes = plt.subplots(3, 1, figsize=(8, 8), sharex=True)
-    axes[0].plot(t, run.first_line_force(), lw=0.9, label="total")
-    axes[0].plot(t, run.first_line_force("in_plane"), lw=0.9, label="in the plane")
-    axes[0].set_ylabel("first-line force (N)")
-    axes[0].legend(fontsize="small")
-    axes[1].plot(t, run.mean_coordination(), lw=0.9, color="black")
-    axes[1].set_ylabel("mean coordination")
-    for name, s in speeds.items():
-        axes[2].plot(t, 1e3 * s, lw=0.9, label=name.replace("_", " "))
-    axes[2].set_ylabel("speed (mm/s)")
-    axes[2].set_xlabel("time (s)")
-    axes[2].legend(fontsize="small")
-    fig.suptitle(f"default table, E = {table.young_modulus:.3g} Pa", fontsize="medium")
-    fig.tight_layout()
-    series_png = savefig_atomic(fig, out / "table_time_series.png", dpi=110)
-    plt.close(fig)
-
-    fig, axes = plt.subplots(1, 2, figsize=(9, 3.5))
-    for ax, field, scale, label in ((axes[0], "normal_speed", 1e3, "normal impact speed (mm/s)"),
-                                    (axes[1], "impact_angle", 180 / math.pi,
-                                     "impact angle (deg)")):
-        if len(onsets):
-            counts, edges = onset_histogram(onsets, field, bins=40)
-            ax.stairs(counts, scale * edges, fill=True)
-        ax.set_xlabel(label)
-        ax.set_ylabel("contact onsets")
-    fig.tight_layout()
-    coll_png = savefig_atomic(fig, out / "collisions.png", dpi=110)
-    plt.close(fig)
-
-    end_png = plot_table_snapshot(out / "table_end.png", table.build(), run.positions[-1],
-                                  time=float(t[-1]))
-    pvd = _write_vtk_series(out / "vtk", run, max(sample_interval, duration / 20))
-
+    result = write_analysis(out, run, table, duration, discard, sample_interval, log)
+    result = {"calibration": {"v_rel_m_per_s": v_rel, "young_modulus_Pa": cal.E.tolist(),
+                              "models": list(cal.models), "max_force_N": cal.forces.tolist()},
+              **result}
+    result["files"] = [str(p) for p in (cal_csv, cal_png, run_path)] + result["files"]
+    result["not_yet"] = list(NOT_YET)
     log("\n== not in demfem yet ==")
     for stage in NOT_YET:
         log(f"  {stage}")
-    result = {
-        "calibration": {"v_rel_m_s": v_rel, "young_modulus_Pa": cal.E.tolist(),
-                        "models": list(cal.models),
-                        "max_force_N": cal.forces.tolist()},
-        "table": {"young_modulus_Pa": table.young_modulus, "n_spheres": table.n_spheres,
-                  "duration_s": duration, "statistics_from_s": discard, **summary, **tagged},
-        "collisions": collisions,
-        "not_yet": list(NOT_YET),
-        "files": [str(p) for p in (cal_csv, cal_png, run_path, coll_csv, series_png, coll_png,
-                                   end_png, pvd)],
-    }
-    summary_path = write_text_atomic(out / "summary.json",
-                                     json.dumps(result, indent=1, default=float) + "\n")
+    summary_path = write_json_atomic(out / "summary.json", result)
+    write_json_atomic(record_path, {**record, "status": "complete",
+                                    "table_run_sha256": sha256_file(run_path)})
     log(f"\nwritten to {out}: " + ", ".join(str(Path(p).relative_to(out))
                                           for p in result["files"])
-        + f", {summary_path.name}")
+        + f", {summary_path.name}, {record_path.name}")
     return result

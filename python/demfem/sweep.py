@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any, Callable, Mapping, Optional, Sequence
 
 from demfem.errors import InvalidParameterError
-from demfem.io import write_text_atomic
+from demfem.io import write_json_atomic, write_text_atomic
 
 __all__ = ["grid_points", "run_key", "resolve_runner", "sweep", "SweepResult", "parse_grid_option"]
 
@@ -72,21 +72,8 @@ def _run_one(runner_spec: "str | Callable[[dict], dict]", params: dict, path: st
     if not isinstance(result, Mapping):
         raise InvalidParameterError(f"invalid runner result = {result!r}: must be a dict")
     record = {"params": params, "result": dict(result), "wall_time_s": time.perf_counter() - t0}
-    write_text_atomic(path, json.dumps(record, indent=1, default=_json_default))
+    write_json_atomic(path, record, default=str)
     return record
-
-
-def _json_default(x: Any) -> Any:
-    try:
-        import numpy as np
-
-        if isinstance(x, np.generic):
-            return x.item()
-        if isinstance(x, np.ndarray):
-            return x.tolist()
-    except ImportError:  # pragma: no cover
-        pass
-    return str(x)
 
 
 @dataclass(frozen=True)

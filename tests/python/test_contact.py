@@ -102,7 +102,7 @@ def test_python_and_rust_laws_agree():
     for model, kw in (("hertz", {"k_h": k_h}), ("linear", {"k": k_r}),
                       ("hertz_reissner", {"k_h": k_h, "k_r": k_r})):
         f_py = normal_force(d, model, **kw)
-        f_rs, stiff = core.normal_force(model, d, **kw)
+        f_rs, stiff = core.normal_force(d, model, **kw)
         np.testing.assert_allclose(f_rs, f_py, rtol=1e-12, atol=0)
         # the tangent stiffness is the derivative of the force (central difference check)
         h = d * 1e-6
@@ -111,7 +111,7 @@ def test_python_and_rust_laws_agree():
     for v in (1e-4, 0.2, 10.0):
         for model, kw in (("hertz", {"k_h": k_h}), ("hertz_reissner", {"k_h": k_h, "k_r": k_r})):
             py = max_contact_force(a, a, v, "hertz" if model == "hertz" else "hertz_reissner")
-            rs = core.max_impact_force(model, a.mass / 2, v, **kw)
+            rs = core.max_impact_force(a.mass / 2, v, model, **kw)
             assert rs == pytest.approx(py, rel=1e-12)
 
 
@@ -141,11 +141,32 @@ def test_clamping_changes_the_realised_restitution():
     assert 0.54 < e_clamped < 0.56
 
 
+def test_core_functions_take_the_python_argument_order():
+    """Same name, same argument names and order in demfem.contact and demfem._core."""
+    import inspect
+
+    assert list(inspect.signature(rayleigh_time_step).parameters) == ["radius", "E", "nu",
+                                                                       "density"]
+    assert core.rayleigh_time_step(radius=0.01, E=45e9, nu=0.22, density=2230.0) == \
+        pytest.approx(rayleigh_time_step(radius=0.01, E=45e9, nu=0.22, density=2230.0),
+                      rel=1e-14)
+    d = np.array([1e-6, 2e-6])
+    np.testing.assert_allclose(core.normal_force(overlap=d, model="hertz", k_h=1e9)[0],
+                               normal_force(overlap=d, model="hertz", k_h=1e9), rtol=1e-14)
+
+
+def test_hertz_impact_duration_is_the_bodies_contact_duration():
+    a = body(shell=False)
+    k_h = hertz_stiffness(a.radius, a.radius, a.E, a.nu, a.E, a.nu)
+    assert core.hertz_impact_duration(k_h, a.mass / 2, 0.2) == pytest.approx(
+        hertz_contact_duration(a, a, 0.2), rel=1e-9)
+
+
 def test_rayleigh_step_and_core_agree():
     s = CART.equivalent_sphere()
     m = CART.material
     py = rayleigh_time_step(s.radius, m.E, m.nu, m.density)
-    assert core.rayleigh_time_step(s.radius, m.density, m.E, m.nu) == pytest.approx(py, rel=1e-14)
+    assert core.rayleigh_time_step(s.radius, m.E, m.nu, m.density) == pytest.approx(py, rel=1e-14)
     # about 0.1-0.2 of the sphere's P-wave transit time, as is usual for glass
     assert 5e-6 < py < 2e-5
 
@@ -170,8 +191,9 @@ def test_k_eq_and_linear_are_series():
     (lambda: max_contact_force(body(), body(), float("inf")), "v_rel"),
     (lambda: max_contact_force(body(), body(), 0.2, "elastic"), "model"),
     (lambda: tsuji_damping_for_restitution(1.5), "restitution"),
-    (lambda: core.normal_force("hertz", np.array([1e-6]), k_h=-1.0), "k_H"),
-    (lambda: core.rayleigh_time_step(0.01, 2230.0, 45e9, 0.5), "nu"),
+    (lambda: core.normal_force(np.array([1e-6]), "hertz", k_h=-1.0), "k_H"),
+    (lambda: core.rayleigh_time_step(0.01, 45e9, 0.5, 2230.0), "nu"),
+    (lambda: core.rayleigh_time_step(radius=0.01, E=45e9, nu=0.2, density=-1.0), "density"),
 ])
 def test_bad_input_names_the_field(call, field):
     with pytest.raises(InvalidParameterError, match=field) as exc:

@@ -58,9 +58,13 @@ def test_the_outputs_agree_with_each_other_and_say_what_is_missing(short_run):
     assert "equivalent sphere" in text and "Fig. 3 analogue" in text
     rows = list(csv.DictReader(open(out / "collisions.csv")))
     assert len(rows) == summary["collisions"]["n_onsets"] > 0
-    speeds = np.array([float(r["normal_speed_m_s"]) for r in rows])
-    assert summary["collisions"]["normal_speed_m_s"][-1] == pytest.approx(speeds.max())
-    assert summary["collisions"]["normal_speed_m_s"][0] == pytest.approx(np.median(speeds))
+    speeds = np.array([float(r["normal_speed_m_per_s"]) for r in rows])
+    assert summary["collisions"]["normal_speed_m_per_s"][-1] == pytest.approx(speeds.max())
+    assert summary["collisions"]["normal_speed_m_per_s"][0] == pytest.approx(np.median(speeds))
+    # angles in degrees in both files, in [0, 90]: atan2(v_t, v_n) with v_n > 0 at onset
+    angles = np.array([float(r["impact_angle_deg"]) for r in rows])
+    assert 0.0 <= angles.min() and angles.max() <= 90.0
+    assert summary["collisions"]["impact_angle_deg"][-1] == pytest.approx(angles.max())
     cal = np.loadtxt(out / "calibration.csv", delimiter=",", skiprows=1)
     assert np.allclose(cal[:, 1:5].T, summary["calibration"]["max_force_N"], rtol=1e-6)
     assert {str(Path(f).relative_to(out)) for f in summary["files"]} == {
@@ -70,6 +74,10 @@ def test_the_outputs_agree_with_each_other_and_say_what_is_missing(short_run):
         assert Path(f).exists()
     assert "vtk/table.pvd" in text
     assert not (out / "table.ck").exists()  # the checkpoint goes once the run is done
+    record = json.loads((out / "run.json").read_text())
+    assert record["status"] == "complete"
+    assert record["settings"]["duration_s"] == 0.05
+    assert record["settings"]["scene_toml"] == AccumulationTable().toml_text()
     for png in ("calibration_force_vs_E.png", "table_time_series.png", "collisions.png",
                 "table_end.png"):
         assert (out / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
@@ -92,8 +100,8 @@ def test_an_interrupted_job_resumes_and_ends_as_an_uninterrupted_one(short_run, 
     resumed = run_pipeline(tmp_path, duration=0.05, sample_interval=0.01,
                            log=lambda _: None, progress=lambda t, steps: seen.append(t))
     assert min(seen) > 0.025  # resumed after the checkpoint at 0.02 s, not started afresh
-    for key in ("force_mean_N", "force_peak_N", "coordination_mean", "max_overlap_m",
-                "n_onsets", "triangular_centre_mean_speed_mm_s"):
+    for key in ("first_line_force_mean_N", "first_line_force_peak_N", "mean_coordination",
+                "max_overlap_m", "n_onsets", "triangular_centre_mean_speed_m_per_s"):
         assert resumed["table"][key] == whole["table"][key]
     assert resumed["collisions"] == whole["collisions"]
 

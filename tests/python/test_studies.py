@@ -113,10 +113,13 @@ def test_checkpoint_resume_matches_uninterrupted_run(tiny_run, tmp_path):
     assert resumed.info["steps"] == tiny_run.info["steps"]
 
 
-def test_mismatched_checkpoint_pair_starts_afresh(tiny_run, tmp_path):
-    """A crash between the two renames leaves an engine state and a record of different
-    times: the run must notice and start again rather than splice them."""
+def test_mismatched_checkpoint_pair_is_refused_and_fresh_starts_afresh(tiny_run, tmp_path):
+    """An engine state and a record that do not belong together (a record file replaced by
+    an older one) are refused, naming the file, rather than spliced; fresh=True starts
+    again and reaches the uninterrupted run."""
     import shutil
+
+    from demfem.errors import CheckpointError
 
     ckpt = tmp_path / "run.ckpt"
     record = tmp_path / "run.ckpt.record.npz"
@@ -134,9 +137,36 @@ def test_mismatched_checkpoint_pair_starts_afresh(tiny_run, tmp_path):
         if limit == 0.05:
             shutil.copy(record, tmp_path / "old.npz")
     shutil.copy(tmp_path / "old.npz", record)  # engine at ~0.16 s, record up to ~0.06 s
-    resumed = run_table(AccumulationTable(**TINY), 0.4, sample_interval=0.02, checkpoint=ckpt)
+    with pytest.raises(CheckpointError, match="run.ckpt.record.npz"):
+        run_table(AccumulationTable(**TINY), 0.4, sample_interval=0.02, checkpoint=ckpt)
+    resumed = run_table(AccumulationTable(**TINY), 0.4, sample_interval=0.02, checkpoint=ckpt,
+                        fresh=True)
     np.testing.assert_array_equal(resumed.positions, tiny_run.positions)
     assert resumed.n_frames == tiny_run.n_frames
+
+
+def test_a_crash_after_the_checkpoint_commit_is_finished_on_resume(tiny_run, tmp_path):
+    """The metadata (with the new files' SHA-256) is the commit: new files left under their
+    temporary names by a crash after it are renamed into place by the next resume."""
+    import os
+
+    ckpt = tmp_path / "run.ckpt"
+
+    def stop(sim_time, steps):
+        if sim_time > 0.1:
+            raise _Stop
+
+    with pytest.raises(_Stop):
+        run_table(AccumulationTable(**TINY), 0.4, sample_interval=0.02, checkpoint=ckpt,
+                  checkpoint_every=1e-9, progress=stop)
+    os.replace(ckpt, tmp_path / "run.ckpt.new")
+    os.replace(tmp_path / "run.ckpt.record.npz", tmp_path / "run.ckpt.record.npz.new.npz")
+    seen = []
+    resumed = run_table(AccumulationTable(**TINY), 0.4, sample_interval=0.02, checkpoint=ckpt,
+                        progress=lambda t, n: seen.append(t))
+    assert min(seen) > 0.1
+    np.testing.assert_array_equal(resumed.positions, tiny_run.positions)
+    assert not list(tmp_path.iterdir())  # everything removed at the end
 
 
 def test_run_table_rejects_bad_arguments():
@@ -152,13 +182,14 @@ def test_run_table_rejects_bad_arguments():
 def test_sweep_point_returns_summary_and_saves_the_run(tmp_path):
     params = {**TINY, "duration": 0.1, "sample_interval": 0.02, "run_dir": str(tmp_path)}
     result = sweep_point(params)
-    for key in ("force_mean_N", "force_peak_N", "force_q95_N", "coordination_mean",
-                "n_removed", "riding_up_end", "max_overlap_m", "sim_wall_time_s", "run_file"):
+    for key in ("first_line_force_mean_N", "first_line_force_peak_N",
+                "first_line_force_q95_N", "mean_coordination", "n_removed", "n_riding_up_end",
+                "max_overlap_m", "wall_time_s", "run_file"):
         assert key in result, key
-    assert result["force_peak_N"] >= result["force_q95_N"] >= 0
+    assert result["first_line_force_peak_N"] >= result["first_line_force_q95_N"] >= 0
     assert result["run_file"] == str(tmp_path / f"{run_key(params)}.npz")
     run = TableRun.load(result["run_file"])
-    assert run.n_frames == 6 and math.isclose(result["force_mean_N"],
+    assert run.n_frames == 6 and math.isclose(result["first_line_force_mean_N"],
                                               float(np.nanmean(run.first_line_force())))
     with pytest.raises(InvalidParameterError, match="duration"):
         sweep_point(TINY)

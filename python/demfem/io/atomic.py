@@ -13,7 +13,8 @@ from demfem.errors import DemfemIOError
 
 PathLike = Union[str, "os.PathLike[str]"]
 
-__all__ = ["atomic_path", "write_bytes_atomic", "write_text_atomic", "savefig_atomic"]
+__all__ = ["atomic_path", "write_bytes_atomic", "write_text_atomic", "savefig_atomic",
+           "clean_stale_temporaries"]
 
 
 @contextmanager
@@ -68,3 +69,22 @@ def savefig_atomic(fig, path: PathLike, **kwargs) -> Path:
     with atomic_path(target, suffix=target.suffix) as tmp:
         fig.savefig(tmp, **kwargs)
     return target
+
+
+def clean_stale_temporaries(folder: PathLike) -> list[Path]:
+    """Remove the temporary files that :func:`atomic_path` left in ``folder`` (and its
+    sub-folders) when a process died before renaming them (``.<name>.<random>.tmp*``);
+    returns the paths removed. Call it at the start of a job that owns ``folder``."""
+    root = Path(folder)
+    removed: list[Path] = []
+    if not root.is_dir():
+        return removed
+    for p in root.rglob(".*.tmp*"):
+        if p.is_file() and ".tmp" in p.name:
+            try:
+                p.unlink()
+            except OSError as exc:
+                raise DemfemIOError(f"i/o error on {p}: cannot remove a stale temporary "
+                                    f"file: {exc}") from None
+            removed.append(p)
+    return removed

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Iterable, Mapping
+from typing import Any, Iterable, Mapping
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
@@ -17,7 +17,7 @@ import numpy as np
 from demfem.errors import InvalidParameterError, ShapeError
 from demfem.io.atomic import write_text_atomic
 
-__all__ = ["write_vtp", "write_pvd"]
+__all__ = ["write_vtp", "write_pvd", "write_vtk_series"]
 
 
 def _vtk_type(values: np.ndarray, name: str) -> tuple[str, np.ndarray]:
@@ -115,3 +115,38 @@ def write_pvd(path: str | Path, frames: Iterable[tuple[float, str | Path]]) -> P
         "<Collection>", *entries, "</Collection>", "</VTKFile>", "",
     ])
     return write_text_atomic(path, text)
+
+
+def write_vtk_series(folder: str | Path, run: Any, interval: float,
+                     name: str = "table") -> Path:
+    """Write a sampled run as ParaView frames: ``<name>_<k>.vtp`` every ``interval`` s
+    (present spheres only, with their ``index``, ``radius`` (m), ``tag``, ``velocity``
+    (m/s), ``force`` (N) and ``coordination``) and ``<name>.pvd`` listing them; returns the
+    ``.pvd`` path.
+
+    ``run`` is a :class:`demfem.studies.TableRun` (or any object with its ``times``,
+    ``positions``, ``velocities``, ``forces``, ``coordination``, ``present``, ``radii`` and
+    ``tags`` arrays). Frames of an earlier series of the same ``name`` in ``folder`` are
+    removed first, so the folder never mixes two runs.
+    """
+    folder = Path(folder)
+    interval = float(interval)
+    if not (math.isfinite(interval) and interval > 0):
+        raise InvalidParameterError(f"invalid interval = {interval!r}: must be a finite "
+                                    "number of seconds > 0")
+    times = np.asarray(run.times, float)
+    step = float(times[1] - times[0]) if len(times) > 1 else interval
+    stride = max(1, int(round(interval / step)))
+    if folder.is_dir():
+        for old in folder.glob(f"{name}_*.vtp"):
+            old.unlink()
+    entries = []
+    for k in range(0, len(times), stride):
+        ok = run.present[k]
+        file = f"{name}_{k:05d}.vtp"
+        write_vtp(folder / file, run.positions[k][ok], {
+            "index": np.flatnonzero(ok), "radius": run.radii[ok], "tag": run.tags[ok],
+            "velocity": run.velocities[k][ok], "force": run.forces[k][ok],
+            "coordination": run.coordination[k][ok].astype(np.int64)})
+        entries.append((float(times[k]), file))
+    return write_pvd(folder / f"{name}.pvd", entries)

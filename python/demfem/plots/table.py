@@ -82,6 +82,24 @@ def _setup_axes(ax, scene: SceneDescription) -> None:
                           markeredgecolor="black", label=TAG_NAMES[t])
                for t, c in TAG_COLOURS.items() if t != Tag.NONE]
     ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
+    _belt_arrow(ax, scene)
+
+
+def _belt_arrow(ax, scene: SceneDescription) -> None:
+    """An arrow in the lower left corner along the belt's surface velocity, labelled with
+    its speed (m/s); nothing if the scene has no moving belt."""
+    for w in scene.walls:
+        v = np.asarray(w.get("surface_velocity", np.zeros(3)), float)[:2]
+        if w.get("name") == "belt" and np.linalg.norm(v) > 0:
+            d = v / np.linalg.norm(v)
+            start = np.array([0.03, 0.06])
+            end = start + 0.12 * d * np.array([1.0, 2.2])  # axes fractions: table is wide
+            ax.annotate("", xy=tuple(end), xytext=tuple(start), xycoords="axes fraction",
+                        arrowprops={"arrowstyle": "-|>", "color": "tab:blue", "lw": 2.0})
+            ax.annotate(f"belt {np.linalg.norm(v):.3g} m/s", xy=tuple(end),
+                        xycoords="axes fraction", xytext=(4, -3), textcoords="offset points",
+                        color="tab:blue", fontsize="small", va="center")
+            return
 
 
 def plot_table_snapshot(path: str | Path, scene: SceneDescription,

@@ -35,7 +35,8 @@ from demfem.analysis import (  # noqa: E402
     tagged_speed,
 )
 from demfem.errors import InvalidParameterError  # noqa: E402
-from demfem.io import savefig_atomic, write_pvd, write_text_atomic, write_vtp  # noqa: E402
+from demfem.io import (json_dumps, savefig_atomic, write_json_atomic,  # noqa: E402
+                       write_text_atomic, write_vtk_series)
 from demfem.scenes.table import Tag  # noqa: E402
 from demfem.studies.table_run import TableRun, table_from_params  # noqa: E402
 
@@ -346,7 +347,7 @@ def fig6(opts: StudyOptions, stiff_duration: Optional[float] = None,
     findings["mean_abs_difference_to_smallest_E"] = differences
     findings["riding_up_max"] = {f"{e:.3g}": int(run.riding_up.max()) for e, run in runs}
     findings["wall_time_s"] = {f"{e:.3g}": float(run.info["wall_time_s"]) for e, run in runs}
-    write_text_atomic(opts.out / "fig6_findings.json", json.dumps(findings, indent=1) + "\n")
+    write_json_atomic(opts.out / "fig6_findings.json", findings)
     opts.log(_format_fig6(findings))
     return findings
 
@@ -481,7 +482,7 @@ def fig7(opts: StudyOptions, stiff_duration: Optional[float] = None,
     fig.tight_layout()
     savefig_atomic(fig, opts.out / "fig7_rectangular_centre_speed.png", dpi=120)
     plt.close(fig)
-    write_text_atomic(opts.out / "fig7_findings.json", json.dumps(findings, indent=1) + "\n")
+    write_json_atomic(opts.out / "fig7_findings.json", findings)
     opts.log("Fig. 7 findings (rectangular centre speed):\n" + "\n".join(
         f"  E={e:>8} Pa, {v['duration_s']:g} s: mean {v['mean_speed_mm_s']:.1f} mm/s, peak "
         f"{v['peak_speed_mm_s']:.1f} mm/s, left at {v['left_at_s']} s; per {window:g} s: "
@@ -558,7 +559,7 @@ def fig8_9(opts: StudyOptions, snapshot_times: Sequence[float] = (9.3, 12.2),
     stride = max(1, int(round(animation_interval / (t[1] - t[0]))))
     gif = animate_table(opts.out / "movie1_table.gif", scene, run.positions[::stride],
                         t[::stride].tolist(), fps=10, dpi=60)
-    pvd = _write_vtk_series(opts.out / "vtk", run, vtk_interval)
+    pvd = write_vtk_series(opts.out / "vtk", run, vtk_interval)
 
     present_tri = np.isfinite(s_tri)
     exit_time = float(t[present_tri][-1]) if not present_tri[-1] else math.nan
@@ -573,8 +574,8 @@ def fig8_9(opts: StudyOptions, snapshot_times: Sequence[float] = (9.3, 12.2),
         "riding_up_max": int(run.riding_up.max()),
         "snapshots": snaps, "animation": str(gif), "paraview": str(pvd),
     }
-    write_text_atomic(opts.out / "fig8_9_findings.json", json.dumps(findings, indent=1) + "\n")
-    opts.log("Figs. 8-9 findings:\n" + json.dumps(findings, indent=1))
+    write_json_atomic(opts.out / "fig8_9_findings.json", findings)
+    opts.log("Figs. 8-9 findings:\n" + json_dumps(findings, indent=1))
     return findings
 
 
@@ -584,19 +585,3 @@ def _correlation(a: np.ndarray, b: np.ndarray) -> float:
     if ok.sum() < 3 or np.std(a[ok]) == 0 or np.std(b[ok]) == 0:
         return math.nan
     return float(np.corrcoef(a[ok], b[ok])[0, 1])
-
-
-def _write_vtk_series(folder: Path, run: TableRun, interval: float) -> Path:
-    """``.vtp`` snapshots every ``interval`` s (present spheres only, with their index) and a
-    ``table.pvd`` that lists them; returns the ``.pvd`` path."""
-    stride = max(1, int(round(interval / (run.times[1] - run.times[0]))))
-    entries = []
-    for k in range(0, run.n_frames, stride):
-        ok = run.present[k]
-        name = f"table_{k:05d}.vtp"
-        write_vtp(folder / name, run.positions[k][ok], {
-            "index": np.flatnonzero(ok), "radius": run.radii[ok], "tag": run.tags[ok],
-            "velocity": run.velocities[k][ok], "force": run.forces[k][ok],
-            "coordination": run.coordination[k][ok].astype(np.int64)})
-        entries.append((float(run.times[k]), name))
-    return write_pvd(folder / "table.pvd", entries)

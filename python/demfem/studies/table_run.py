@@ -29,12 +29,16 @@ import numpy as np
 from demfem.analysis.collisions import ONSET_DTYPE
 from demfem.analysis.forces import first_line_force, force_statistics
 from demfem.analysis.coordination import mean_coordination
-from demfem.errors import DemfemIOError, InvalidParameterError
+from demfem.errors import (CheckpointError, DemfemIOError, InvalidParameterError,
+                           SettingsMismatchError)
 from demfem.io.atomic import atomic_path
+from demfem.io.strict_json import dumps as json_dumps
 from demfem.progress import ProgressBar
 from demfem.scenes.table import AccumulationTable
 
-__all__ = ["TableRun", "run_table", "sweep_point", "table_from_params", "RUN_OPTIONS"]
+__all__ = ["TableRun", "run_table", "sweep_point", "table_from_params", "RUN_OPTIONS",
+           "check_run_arguments", "checkpoint_files", "checkpoint_state", "run_settings",
+           "settings_differences", "sha256_file", "remove_checkpoint"]
 
 #: Keys of a sweep point that configure the run rather than the table (see :func:`sweep_point`).
 RUN_OPTIONS = ("duration", "sample_interval", "model", "run_dir", "checkpoint_every",
@@ -136,8 +140,7 @@ class TableRun:
         arrays = {name: getattr(self, name) for name in _ARRAYS}
         arrays.update(tags=self.tags, radii=self.radii, removal_times=self.removal_times,
                       onsets=self.onsets)
-        document = json.dumps({"parameters": self.parameters, "info": self.info},
-                              default=_json_default)
+        document = json_dumps({"parameters": self.parameters, "info": self.info})
         target = Path(path)
         with atomic_path(target, suffix=".npz") as tmp:
             with open(tmp, "wb") as fh:
@@ -164,37 +167,35 @@ class TableRun:
         return cls(parameters=document["parameters"], info=document["info"], **arrays)
 
     def summary(self, discard_before: float = 0.0, quantile: float = 0.95) -> dict[str, float]:
-        """Numbers for a sweep table: first-line force mean / peak / quantile (N) after
-        ``discard_before`` (s), total and in-plane (see :meth:`first_line_force`), mean coordination of the present spheres, spheres removed,
-        spheres riding up at the end, largest overlap (m)."""
+        """Numbers for a sweep table, each key naming its unit (SI; counts ``n_*`` and the
+        dimensionless coordination carry none): first-line force mean / peak / quantile
+        (N, per-sphere mean, see :meth:`first_line_force`) after ``discard_before`` (s), total
+        and in the plane, mean coordination of the present spheres, spheres removed, spheres
+        riding up at the end and at most, largest overlap (m), contact onsets, time step (s)
+        and wall time (s)."""
         keep = self.times >= discard_before
         stats = force_statistics(self.first_line_force()[keep], quantile)
         plane = force_statistics(self.first_line_force("in_plane")[keep], quantile)
         z = self.mean_coordination()
+        q = f"q{100 * quantile:g}"
         return {
-            "force_mean_N": stats["mean"],
-            "force_peak_N": stats["peak"],
-            "force_q95_N" if quantile == 0.95 else f"force_q{quantile:g}_N": stats["quantile"],
-            "in_plane_force_mean_N": plane["mean"],
-            "in_plane_force_peak_N": plane["peak"],
-            "in_plane_force_quantile_N": plane["quantile"],
-            "coordination_mean": float(np.nanmean(z[keep])),
+            "first_line_force_mean_N": stats["mean"],
+            "first_line_force_peak_N": stats["peak"],
+            f"first_line_force_{q}_N": stats["quantile"],
+            "first_line_in_plane_force_mean_N": plane["mean"],
+            "first_line_in_plane_force_peak_N": plane["peak"],
+            f"first_line_in_plane_force_{q}_N": plane["quantile"],
+            "mean_coordination": float(np.nanmean(z[keep])),
             "n_removed": int(np.isfinite(self.removal_times).sum()),
-            "riding_up_end": int(self.riding_up[-1]),
-            "riding_up_max": int(self.riding_up.max()),
+            "n_riding_up_end": int(self.riding_up[-1]),
+            "n_riding_up_max": int(self.riding_up.max()),
             "max_overlap_m": float(np.nanmax(self.max_overlap)),
             "n_onsets": int(len(self.onsets)),
-            "dt_s": float(self.info.get("dt", math.nan)),
-            "sim_wall_time_s": float(self.info.get("wall_time_s", math.nan)),
+            "time_step_s": float(self.info.get("dt", math.nan)),
+            "wall_time_s": float(self.info.get("wall_time_s", math.nan)),
         }
 
 
-def _json_default(x: Any) -> Any:
-    if isinstance(x, np.generic):
-        return x.item()
-    if isinstance(x, np.ndarray):
-        return x.tolist()
-    raise TypeError(f"not JSON serialisable: {type(x).__name__}")
 
 
 # --------------------------------------------------------------------------------------------
@@ -296,12 +297,15 @@ def _nearest_frame(frame_times: np.ndarray, t: np.ndarray) -> np.ndarray:
     return np.where(left_nearer, k - 1, k)
 
 
-def _check_run_arguments(duration: float, sample_interval: float, threads: int) -> None:
+def check_run_arguments(duration: float, sample_interval: float, threads: int) -> None:
     for name, value in (("duration", duration), ("sample_interval", sample_interval)):
         if not (isinstance(value, (int, float, np.floating)) and math.isfinite(value)
                 and value > 0):
             raise InvalidParameterError(f"invalid {name} = {value!r}: must be a finite "
                                         "number of seconds > 0")
+    if isinstance(duration, bool) or isinstance(sample_interval, bool):
+        raise InvalidParameterError("invalid duration or sample_interval: must be a number "
+                                    "of seconds, not a boolean")
     if sample_interval > duration:
         raise InvalidParameterError(f"invalid sample_interval = {sample_interval!r}: must not "
                                     f"exceed duration = {duration!r} s")
@@ -310,11 +314,50 @@ def _check_run_arguments(duration: float, sample_interval: float, threads: int) 
                                     ">= 1")
 
 
+def run_settings(table: AccumulationTable, duration: float, sample_interval: float,
+                 model: str, dt: Optional[float]) -> dict[str, Any]:
+    """What makes a run's result: the table's fields, ``duration_s``, ``sample_interval_s``,
+    ``model`` and the requested ``dt_s`` (None: the engine's safe step). Threads are not in
+    it: results are bitwise the same on any number. Strict-JSON values."""
+    from demfem.io.strict_json import finite_or_none
+
+    return finite_or_none({"scene": dataclasses.asdict(table), "duration_s": float(duration),
+                           "sample_interval_s": float(sample_interval), "model": model,
+                           "dt_s": None if dt is None else float(dt)})
+
+
+def settings_differences(recorded: Mapping[str, Any], now: Mapping[str, Any],
+                         prefix: str = "") -> list[str]:
+    """``"name: <recorded> -> <now>"`` for each setting that differs (nested dicts by
+    dotted name)."""
+    out = []
+    for key in sorted(set(recorded) | set(now)):
+        a, b = recorded.get(key), now.get(key)
+        name = f"{prefix}{key}"
+        if isinstance(a, Mapping) and isinstance(b, Mapping):
+            out += settings_differences(a, b, name + ".")
+        elif a != b:
+            out.append(f"{name}: {a!r} -> {b!r}")
+    return out
+
+
+def sha256_file(path: Path) -> str:
+    """Hex SHA-256 of a file's bytes."""
+    import hashlib
+
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
 def run_table(table: AccumulationTable, duration: float, sample_interval: float = 0.05,
               threads: int = 1, model: str = "hertz_reissner_mindlin",
               progress: Optional[Callable[[float, int], None]] = None,
               checkpoint: Optional[str | Path] = None, checkpoint_every: float = 300.0,
-              dt: Optional[float] = None) -> TableRun:
+              dt: Optional[float] = None, fresh: bool = False,
+              overlap_fraction: float = 0.1) -> TableRun:
     """Run ``table`` for ``duration`` s of simulated time and sample it every
     ``sample_interval`` s (samples at 0, Δ, 2Δ, ... up to ``duration``).
 
@@ -328,38 +371,43 @@ def run_table(table: AccumulationTable, duration: float, sample_interval: float 
         model: contact law, see :func:`demfem.dem.from_scene`.
         progress: callback ``progress(sim_time_s, steps)``, e.g. a
             :class:`demfem.progress.ProgressBar`.
-        checkpoint: engine checkpoint file; if it exists (with its ``.record.npz``), the run
-            resumes from it. Written every ``checkpoint_every`` wall seconds; removed at the end.
+        checkpoint: engine checkpoint file; if it exists (with its ``.record.npz`` and its
+            ``.json`` holding the run's settings and the files' SHA-256), the run resumes from
+            it. Written every ``checkpoint_every`` wall seconds; removed at the end. A
+            checkpoint made with other settings raises :class:`SettingsMismatchError` naming
+            them, a damaged one :class:`CheckpointError` naming the file (unless ``fresh``).
         checkpoint_every: wall time between checkpoints, s.
         dt: time step, s (default: the engine's safe step).
+        fresh: ignore (and remove) an existing checkpoint and start at t = 0.
+        overlap_fraction: physical sanity check at every sample: a sphere sunk into the belt
+            or an overlap deeper than this fraction of the radius raises
+            :class:`demfem.errors.NumericalError` (see :func:`demfem.dem.check_state`).
 
     Returns:
         The :class:`TableRun`.
     """
     from demfem.dem import from_scene, refeed_removed
 
-    _check_run_arguments(duration, sample_interval, threads)
+    from demfem.dem import check_state
+
+    check_run_arguments(duration, sample_interval, threads)
     if not (math.isfinite(checkpoint_every) and checkpoint_every > 0):
         raise InvalidParameterError(f"invalid checkpoint_every = {checkpoint_every!r}: must "
                                     "be a finite number of seconds > 0")
     scene = table.build()
+    belt = _belt_plane(scene)
     sim = from_scene(scene, model=model, threads=threads, record_onsets=True, dt=dt)
     n_samples = int(math.floor(duration / sample_interval + 1e-9))
     sample_times = sample_interval * np.arange(n_samples + 1)
     rec = _Recorder(len(scene.radii))
     wall_before = 0.0
+    settings = run_settings(table, duration, sample_interval, model, dt)
     ckpt = Path(checkpoint) if checkpoint is not None else None
-    files = _checkpoint_files(ckpt) if ckpt is not None else None
-    if files is not None and all(p.exists() for p in files[:2]):
-        sim.load_checkpoint(files[0])
-        rec.load_partial(files[1])
-        if files[2].exists():
-            wall_before = float(json.loads(files[2].read_text())["wall_time_s"])
-        if not math.isclose(float(rec.frames["times"][-1]), float(sim.time), rel_tol=0.0,
-                            abs_tol=0.5 * float(sim.dt)):
-            # A crash between the renames of a checkpoint: the pair does not belong together.
-            sim = from_scene(scene, model=model, threads=threads, record_onsets=True, dt=dt)
-            rec, wall_before = _Recorder(len(scene.radii)), 0.0
+    files = checkpoint_files(ckpt) if ckpt is not None else None
+    if ckpt is not None and fresh:
+        remove_checkpoint(ckpt)
+    if ckpt is not None and files is not None and any(p.exists() for p in files):
+        wall_before = _resume(sim, rec, ckpt, settings)
     if not rec.frames["times"]:
         rec.sample(sim, table)
     start = _time.perf_counter()
@@ -372,12 +420,13 @@ def run_table(table: AccumulationTable, duration: float, sample_interval: float 
             refeed_removed(sim, scene.refeed["sites"], scene.refeed["velocity"])
         rec.collect_events(sim)
         rec.sample(sim, table)
+        check_state(sim, floor=belt, overlap_fraction=overlap_fraction)
         k += 1
         if progress is not None:
             progress(float(sim.time), int(sim.steps))
         now = _time.perf_counter()
         if files is not None and now - last_checkpoint >= checkpoint_every and k <= n_samples:
-            _write_checkpoint(sim, rec, files, wall_before + now - start)
+            _write_checkpoint(sim, rec, files, wall_before + now - start, settings)
             last_checkpoint = now
     frames = rec.stacked()
     run = TableRun(
@@ -392,36 +441,124 @@ def run_table(table: AccumulationTable, duration: float, sample_interval: float 
               "wall_time_s": wall_before + _time.perf_counter() - start},
         **frames,
     )
-    if files is not None:
-        for p in files:
-            p.unlink(missing_ok=True)
+    if ckpt is not None:
+        remove_checkpoint(ckpt)
     return run
 
 
-def _checkpoint_files(ckpt: Path) -> tuple[Path, Path, Path]:
-    """The engine checkpoint, the record so far (``.record.npz``) and the wall time used
-    (``.json``)."""
+def checkpoint_files(ckpt: Path) -> tuple[Path, Path, Path]:
+    """The engine checkpoint, the record so far (``.record.npz``) and the metadata
+    (``.json``: settings, wall and simulated time, SHA-256 of the other two)."""
+    ckpt = Path(ckpt)
     return ckpt, Path(str(ckpt) + ".record.npz"), Path(str(ckpt) + ".json")
 
 
-def _write_checkpoint(sim, rec: _Recorder, files: tuple[Path, Path, Path],
-                      wall_time: float) -> None:
-    """Engine state, record so far and wall time used. Each file is replaced atomically; a
-    crash between the two renames leaves an engine state and a record of different times,
-    which :func:`run_table` detects (the record's last sample time is the engine's time) and
-    then starts afresh."""
-    from demfem.io.atomic import write_text_atomic
+def _new_files(ckpt: Path) -> tuple[Path, Path]:
+    """Where the next engine checkpoint and record are written before they are renamed."""
+    engine, record, _ = checkpoint_files(ckpt)
+    return engine.with_name(engine.name + ".new"), record.with_name(record.name + ".new.npz")
 
-    ckpt, record_file, wall_file = files
+
+def remove_checkpoint(ckpt: str | Path) -> None:
+    """Remove a checkpoint's files (engine, record, metadata and unfinished writes)."""
+    for p in (*checkpoint_files(Path(ckpt)), *_new_files(Path(ckpt))):
+        p.unlink(missing_ok=True)
+
+
+def checkpoint_state(ckpt: str | Path) -> Optional[dict[str, Any]]:
+    """The metadata of a checkpoint (``settings``, ``wall_time_s``, ``sim_time_s``,
+    ``sha256``), or None if there is none; a damaged metadata file raises
+    :class:`CheckpointError` naming it."""
+    meta = checkpoint_files(Path(ckpt))[2]
+    if not meta.exists():
+        return None
+    try:
+        state = json.loads(meta.read_text(encoding="utf-8"))
+        if not isinstance(state, dict) or not {"settings", "sha256", "sim_time_s",
+                                               "wall_time_s"} <= set(state):
+            raise ValueError("missing keys")
+    except (OSError, UnicodeDecodeError, ValueError) as exc:
+        raise CheckpointError(f"damaged checkpoint file {meta}: {exc}; start afresh "
+                              "(fresh=True, demfem run --fresh)") from None
+    return state
+
+
+def _resume(sim, rec: _Recorder, ckpt: Path, settings: Mapping[str, Any]) -> float:
+    """Restore ``sim`` and ``rec`` from the checkpoint ``ckpt``; returns the wall time used
+    so far. Refuses other settings and damaged files."""
+    engine, record, meta = checkpoint_files(ckpt)
+    state = checkpoint_state(ckpt)
+    if state is None:
+        raise CheckpointError(f"damaged checkpoint {ckpt}: its metadata {meta} is missing; "
+                              "start afresh (fresh=True, demfem run --fresh)")
+    diff = settings_differences(state["settings"], settings)
+    if diff:
+        raise SettingsMismatchError(
+            f"the checkpoint {ckpt} belongs to a run with other settings ("
+            + "; ".join(diff) + "): run with the same settings to resume it, or start afresh "
+            "(fresh=True, demfem run --fresh)")
+    sums = state["sha256"]
+    # finish an interrupted commit: the metadata already names the new files' checksums
+    for final, new, key in ((engine, _new_files(ckpt)[0], "engine"),
+                            (record, _new_files(ckpt)[1], "record")):
+        if new.exists():
+            if sha256_file(new) == sums.get(key):
+                os.replace(new, final)
+            else:
+                new.unlink()
+    for path, key in ((engine, "engine"), (record, "record")):
+        if not path.exists():
+            raise CheckpointError(f"damaged checkpoint: {path} is missing; start afresh "
+                                  "(fresh=True, demfem run --fresh)")
+        if sha256_file(path) != sums.get(key):
+            raise CheckpointError(f"damaged checkpoint file {path}: its SHA-256 differs from "
+                                  f"the one recorded in {meta} (truncated or altered); start "
+                                  "afresh (fresh=True, demfem run --fresh)")
+    try:
+        sim.load_checkpoint(engine)
+    except Exception as exc:  # the engine's own format errors
+        raise CheckpointError(f"damaged checkpoint file {engine}: {exc}") from None
+    try:
+        rec.load_partial(record)
+    except (OSError, KeyError, ValueError) as exc:
+        raise CheckpointError(f"damaged checkpoint file {record}: {exc}") from None
+    if not math.isclose(float(rec.frames["times"][-1]), float(sim.time), rel_tol=0.0,
+                        abs_tol=0.5 * float(sim.dt)):
+        raise CheckpointError(f"damaged checkpoint {ckpt}: the record ends at "
+                              f"t = {float(rec.frames['times'][-1]):.6g} s but the engine "
+                              f"state is at t = {float(sim.time):.6g} s")
+    return float(state["wall_time_s"])
+
+
+def _write_checkpoint(sim, rec: _Recorder, files: tuple[Path, Path, Path],
+                      wall_time: float, settings: Mapping[str, Any]) -> None:
+    """Engine state, record so far, settings and wall time used, committed like a journal:
+    the new engine state and record are written in full under temporary names, then the
+    metadata with their SHA-256 replaces the old one atomically (the commit), then the two
+    are renamed. A crash before the commit leaves the old checkpoint valid; one after it is
+    finished by the next resume (:func:`_resume`), which finds the new files by checksum."""
+    from demfem.io.strict_json import write_json_atomic
+
+    ckpt, record_file, meta = files
     ckpt.parent.mkdir(parents=True, exist_ok=True)
-    # Both written in full under temporary names first, then renamed one after the other.
-    tmp_ckpt = ckpt.with_name(ckpt.name + ".new")
-    sim.save_checkpoint(tmp_ckpt)
-    rec.save_partial(record_file.with_name(record_file.name + ".new.npz"))
-    os.replace(tmp_ckpt, ckpt)
-    os.replace(record_file.with_name(record_file.name + ".new.npz"), record_file)
-    write_text_atomic(wall_file, json.dumps({"wall_time_s": wall_time,
-                                             "sim_time_s": float(sim.time)}))
+    new_engine, new_record = _new_files(ckpt)
+    sim.save_checkpoint(new_engine)
+    rec.save_partial(new_record)
+    write_json_atomic(meta, {"format": 2, "settings": dict(settings), "wall_time_s": wall_time,
+                             "sim_time_s": float(sim.time),
+                             "sha256": {"engine": sha256_file(new_engine),
+                                        "record": sha256_file(new_record)}})
+    os.replace(new_engine, ckpt)
+    os.replace(new_record, record_file)
+
+
+def _belt_plane(scene) -> Optional[tuple[np.ndarray, np.ndarray]]:
+    """(point, unit normal) of the scene's belt plane, or None if it has none."""
+    for w in scene.walls:
+        if w.get("kind") == "plane" and "belt" in str(w.get("name", "")):
+            n = np.asarray(w["normal"], float)
+            return np.asarray(w["point"], float), n / np.linalg.norm(n)
+    return None
 
 
 # --------------------------------------------------------------------------------------------

@@ -31,6 +31,46 @@ pub(crate) fn invalid(field: &str, value: &str, allowed: &str) -> PyErr {
     .into()
 }
 
+/// Largest time step a DEM simulation accepts, s: with no particles (or no stiffness) the
+/// stable limit is infinite, and a step beyond this is a mistake, not a DEM step.
+pub(crate) const MAX_DT: f64 = 1.0;
+
+/// A converted array (see [`crate::as_float_array`]) as a 2-D float64 view.
+pub(crate) fn float2<'py>(a: &Bound<'py, PyAny>, field: &str) -> PyResult<PyReadonlyArray2<'py, f64>> {
+    a.extract().map_err(|_| {
+        shape_err(field, format!("expected a 2-D array (N, 3), got {} dimensions", ndim(a)))
+    })
+}
+
+/// A converted array as a 1-D float64 view.
+pub(crate) fn float1<'py>(a: &Bound<'py, PyAny>, field: &str) -> PyResult<PyReadonlyArray1<'py, f64>> {
+    a.extract()
+        .map_err(|_| shape_err(field, format!("expected a 1-D array, got {} dimensions", ndim(a))))
+}
+
+/// A converted integer array as a 1-D int64 view.
+pub(crate) fn int1<'py>(a: &Bound<'py, PyAny>, field: &str) -> PyResult<PyReadonlyArray1<'py, i64>> {
+    a.extract()
+        .map_err(|_| shape_err(field, format!("expected a 1-D array, got {} dimensions", ndim(a))))
+}
+
+fn ndim(a: &Bound<'_, PyAny>) -> usize {
+    a.getattr("ndim").and_then(|d| d.extract()).unwrap_or(0)
+}
+
+/// Steps `n` (from Python, signed) checked: >= 0, and the simulated time after them finite.
+pub(crate) fn checked_steps(n: i64, time: f64, dt: f64) -> PyResult<u64> {
+    let n = crate::count("n", n)?;
+    if !(time + n as f64 * dt).is_finite() {
+        return Err(invalid(
+            "n",
+            &n.to_string(),
+            &format!("few enough steps of dt = {dt:e} s that the simulated time stays finite"),
+        ));
+    }
+    Ok(n)
+}
+
 pub(crate) fn vec3s(
     field: &str,
     a: &PyReadonlyArray2<'_, f64>,
@@ -244,15 +284,15 @@ impl DemSimulation {
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
-        positions: PyReadonlyArray2<'_, f64>,
-        radii: PyReadonlyArray1<'_, f64>,
+        positions: &Bound<'_, PyAny>,
+        radii: &Bound<'_, PyAny>,
         materials: &Bound<'_, PyList>,
         walls: &Bound<'_, PyList>,
         effects: Vec<String>,
-        velocities: Option<PyReadonlyArray2<'_, f64>>,
-        angular_velocities: Option<PyReadonlyArray2<'_, f64>>,
-        material_ids: Option<PyReadonlyArray1<'_, i64>>,
-        tags: Option<PyReadonlyArray1<'_, i64>>,
+        velocities: Option<&Bound<'_, PyAny>>,
+        angular_velocities: Option<&Bound<'_, PyAny>>,
+        material_ids: Option<&Bound<'_, PyAny>>,
+        tags: Option<&Bound<'_, PyAny>>,
         gravity: (f64, f64, f64),
         model: &str,
         linear_stiffness: Option<(f64, f64)>,
@@ -261,14 +301,31 @@ impl DemSimulation {
         dt_safety: f64,
         expected_max_speed: f64,
         skin: Option<f64>,
-        threads: usize,
+        threads: i64,
         overlap_tolerance: f64,
-        record_every: u64,
+        record_every: i64,
         record_onsets: bool,
         removal_plane: Option<((f64, f64, f64), (f64, f64, f64))>,
     ) -> PyResult<Self> {
+        if threads < 1 {
+            return Err(invalid("threads", &threads.to_string(), "a whole number >= 1"));
+        }
+        let threads = usize::try_from(threads)
+            .map_err(|_| invalid("threads", &threads.to_string(), "a whole number >= 1"))?;
+        let record_every = crate::count("record_every", record_every)?;
+        if let Some(step) = dt {
+            if !(step.is_finite() && step > 0.0 && step <= MAX_DT) {
+                return Err(invalid(
+                    "dt",
+                    &format!("{step:e}"),
+                    &format!("finite, > 0 and <= {MAX_DT} s (a DEM time step)"),
+                ));
+            }
+        }
+        let positions = float2(&crate::as_float_array(positions, "positions")?, "positions")?;
         let position = vec3s("positions", &positions, None)?;
         let n = position.len();
+        let radii = float1(&crate::as_float_array(radii, "radii")?, "radii")?;
         let radius: Vec<f64> = radii.as_array().to_vec();
         if radius.len() != n {
             return Err(shape_err(
@@ -278,12 +335,18 @@ impl DemSimulation {
         }
         let mut p = ParticleInit::at_rest(position, radius);
         if let Some(v) = velocities {
+            let v = float2(&crate::as_float_array(v, "velocities")?, "velocities")?;
             p.velocity = vec3s("velocities", &v, Some(n))?;
         }
         if let Some(w) = angular_velocities {
+            let w = float2(
+                &crate::as_float_array(w, "angular_velocities")?,
+                "angular_velocities",
+            )?;
             p.angular_velocity = vec3s("angular_velocities", &w, Some(n))?;
         }
         if let Some(m) = material_ids {
+            let m = int1(&crate::as_int_array(m, "material_ids")?, "material_ids")?;
             let m = m.as_array();
             if m.len() != n {
                 return Err(shape_err(
@@ -299,6 +362,7 @@ impl DemSimulation {
                 .collect::<PyResult<_>>()?;
         }
         if let Some(t) = tags {
+            let t = int1(&crate::as_int_array(t, "tags")?, "tags")?;
             let t = t.as_array();
             if t.len() != n {
                 return Err(shape_err(
@@ -416,7 +480,9 @@ impl DemSimulation {
     /// Advance `n` steps, releasing the GIL in chunks of `chunk` steps; Ctrl-C between chunks
     /// raises SimulationInterrupted with the state consistent at a step boundary.
     #[pyo3(signature = (n, chunk=2000))]
-    fn step(&mut self, py: Python<'_>, n: u64, chunk: u64) -> PyResult<()> {
+    fn step(&mut self, py: Python<'_>, n: i64, chunk: i64) -> PyResult<()> {
+        let n = checked_steps(n, self.sim.time(), self.sim.dt())?;
+        let chunk = crate::count("chunk", chunk)?;
         crate::run_in_chunks(
             py,
             &mut self.sim,
@@ -430,9 +496,10 @@ impl DemSimulation {
 
     /// Advance until the simulated time reaches `t_end` (s); returns the steps taken.
     #[pyo3(signature = (t_end, chunk=2000))]
-    fn run_until(&mut self, py: Python<'_>, t_end: f64, chunk: u64) -> PyResult<u64> {
+    fn run_until(&mut self, py: Python<'_>, t_end: f64, chunk: i64) -> PyResult<u64> {
         let n = crate::steps_until(t_end, self.sim.time(), self.sim.dt())?;
-        self.step(py, n, chunk)?;
+        let steps = i64::try_from(n).map_err(|_| invalid("t_end", &t_end.to_string(), "reachable in < 2^63 steps"))?;
+        self.step(py, steps, chunk)?;
         Ok(n)
     }
 

@@ -49,10 +49,17 @@ impl From<PyDemfemError> for PyErr {
     }
 }
 
-/// Advance a simulation `n` steps in chunks of `chunk`, with the GIL released while each
-/// chunk runs. Between chunks `after_chunk` runs with the GIL held (progress callbacks), then
-/// Ctrl-C is checked: it raises `SimulationInterrupted` with the time and step count of the
-/// consistent state reached (`clock`). The one stepping loop of every simulation class.
+/// Longest stretch of wall time the engine runs without the GIL between two checks of
+/// Ctrl-C, s (the slices are sized from the measured speed of the previous one).
+const SIGNAL_CHECK_INTERVAL_S: f64 = 0.1;
+
+/// Advance a simulation `n` steps in chunks of `chunk`, with the GIL released while the
+/// engine runs. Between chunks `after_chunk` runs with the GIL held (progress callbacks).
+/// Each chunk runs in slices of about [`SIGNAL_CHECK_INTERVAL_S`] of wall time, so Ctrl-C is
+/// seen within a fraction of a second whatever `chunk` is: it raises `SimulationInterrupted`
+/// with the time and step count of the consistent state reached (`clock`). The one stepping
+/// loop of every simulation class. Slicing does not change the result: the engine's state
+/// after k steps does not depend on how they were grouped.
 pub(crate) fn run_in_chunks<S: Send>(
     py: Python<'_>,
     state: &mut S,
@@ -64,12 +71,9 @@ pub(crate) fn run_in_chunks<S: Send>(
 ) -> PyResult<()> {
     let chunk = chunk.max(1);
     let mut done = 0;
-    while done < n {
-        let k = chunk.min(n - done);
-        py.detach(|| advance(&mut *state, k))
-            .map_err(PyDemfemError::from)?;
-        done += k;
-        after_chunk(state)?;
+    // steps per slice: starts small, then follows the measured speed
+    let mut slice: u64 = 8;
+    let check = |py: Python<'_>, state: &S| -> PyResult<()> {
         if let Err(e) = py.check_signals() {
             if e.is_instance_of::<pyo3::exceptions::PyKeyboardInterrupt>(py) {
                 let (time, steps) = clock(state);
@@ -77,8 +81,102 @@ pub(crate) fn run_in_chunks<S: Send>(
             }
             return Err(e);
         }
+        Ok(())
+    };
+    while done < n {
+        let mut left = chunk.min(n - done);
+        while left > 0 {
+            let k = slice.min(left);
+            let start = std::time::Instant::now();
+            py.detach(|| advance(&mut *state, k))
+                .map_err(PyDemfemError::from)?;
+            let elapsed = start.elapsed().as_secs_f64();
+            left -= k;
+            done += k;
+            let target = if elapsed > 0.0 {
+                (k as f64 * SIGNAL_CHECK_INTERVAL_S / elapsed).floor()
+            } else {
+                f64::INFINITY
+            };
+            // at most double per slice, so that one slow step cannot be followed by a huge slice
+            slice = (target.min(2.0 * k as f64).max(1.0)) as u64;
+            if left > 0 {
+                check(py, state)?;
+            }
+        }
+        after_chunk(state)?;
+        check(py, state)?;
     }
     Ok(())
+}
+
+/// A count given from Python as a signed integer, refused when negative (instead of
+/// PyO3's OverflowError without a field name).
+pub(crate) fn count(field: &str, value: i64) -> PyResult<u64> {
+    u64::try_from(value).map_err(|_| {
+        PyDemfemError::from(DemfemError::InvalidParameter {
+            field: field.into(),
+            value: value.to_string(),
+            allowed: "a whole number >= 0".into(),
+        })
+        .into()
+    })
+}
+
+/// A real input array converted to float64 (integers and other real dtypes accepted);
+/// anything else raises InvalidParameterError naming `field` (instead of a bare TypeError).
+pub(crate) fn as_float_array<'py>(
+    obj: &Bound<'py, PyAny>,
+    field: &str,
+) -> PyResult<Bound<'py, PyAny>> {
+    as_typed_array(obj, field, "float64", "an array of real numbers")
+}
+
+/// An integer input array converted to int64 (any integer dtype accepted); anything else
+/// raises InvalidParameterError naming `field`.
+pub(crate) fn as_int_array<'py>(obj: &Bound<'py, PyAny>, field: &str) -> PyResult<Bound<'py, PyAny>> {
+    let py = obj.py();
+    let np = py.import("numpy")?;
+    let arr = np.call_method1("asarray", (obj,)).map_err(|_| {
+        PyErr::from(PyDemfemError::from(DemfemError::InvalidParameter {
+            field: field.into(),
+            value: "not an array".into(),
+            allowed: "an array of integers".into(),
+        }))
+    })?;
+    let kind: String = arr.getattr("dtype")?.getattr("kind")?.extract()?;
+    let size: usize = arr.getattr("size")?.extract()?;
+    if !(kind == "i" || kind == "u" || size == 0) {
+        let dtype = arr.getattr("dtype")?.str()?.to_string();
+        return Err(PyDemfemError::from(DemfemError::InvalidParameter {
+            field: field.into(),
+            value: format!("an array of dtype {dtype}"),
+            allowed: "an array of integers".into(),
+        })
+        .into());
+    }
+    as_typed_array(&arr, field, "int64", "an array of integers")
+}
+
+fn as_typed_array<'py>(
+    obj: &Bound<'py, PyAny>,
+    field: &str,
+    dtype: &str,
+    allowed: &str,
+) -> PyResult<Bound<'py, PyAny>> {
+    let py = obj.py();
+    let np = py.import("numpy")?;
+    let kwargs = pyo3::types::PyDict::new(py);
+    kwargs.set_item("dtype", dtype)?;
+    np.call_method("ascontiguousarray", (obj,), Some(&kwargs))
+        .map_err(|e| {
+            PyDemfemError::from(DemfemError::InvalidParameter {
+                field: field.into(),
+                value: e.value(py).to_string(),
+                allowed: allowed.into(),
+            })
+            .into()
+        })
 }
 
 /// Whole steps of `dt` (s) from `time` to reach `t_end` (s), at least 0; `t_end` must be
@@ -116,18 +214,38 @@ fn parse_law(law: &str, k_h: f64, k_r: f64, k: f64) -> CoreResult<NormalLaw> {
 }
 
 /// Normal force (N) and tangent stiffness (N/m) of a law at each overlap (m).
+/// Same argument order as `demfem.contact.normal_force(overlap, model, k_h, k_r, k)`; NaN or
+/// infinite overlaps are refused (InvalidParameterError naming `overlap[i]`).
 #[pyfunction]
-#[pyo3(signature = (law, overlap, k_h=f64::NAN, k_r=f64::NAN, k=f64::NAN))]
+#[pyo3(signature = (overlap, model, k_h=f64::NAN, k_r=f64::NAN, k=f64::NAN))]
 fn normal_force<'py>(
     py: Python<'py>,
-    law: &str,
-    overlap: PyReadonlyArray1<'py, f64>,
+    overlap: &Bound<'py, PyAny>,
+    model: &str,
     k_h: f64,
     k_r: f64,
     k: f64,
 ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
-    let law = parse_law(law, k_h, k_r, k)?;
+    let law = parse_law(model, k_h, k_r, k)?;
+    let overlap = as_float_array(overlap, "overlap")?;
+    let overlap: PyReadonlyArray1<'py, f64> = overlap.extract().map_err(|_| {
+        PyErr::from(PyDemfemError::from(DemfemError::ShapeMismatch {
+            field: "overlap".into(),
+            detail: format!(
+                "expected a 1-D array, got {} dimensions",
+                overlap.getattr("ndim").and_then(|d| d.extract::<usize>()).unwrap_or(0)
+            ),
+        }))
+    })?;
     let d = overlap.as_array();
+    if let Some((i, x)) = d.iter().enumerate().find(|(_, x)| !x.is_finite()) {
+        return Err(PyDemfemError::from(DemfemError::InvalidParameter {
+            field: format!("overlap[{i}]"),
+            value: x.to_string(),
+            allowed: "finite (m)".into(),
+        })
+        .into());
+    }
     let mut f = Vec::with_capacity(d.len());
     let mut s = Vec::with_capacity(d.len());
     for &x in d.iter() {
@@ -138,19 +256,21 @@ fn normal_force<'py>(
     Ok((f.into_pyarray(py), s.into_pyarray(py)))
 }
 
-/// Maximum impact force (N) of two bodies of effective mass m_star (kg) at v_rel (m/s).
+/// Maximum impact force (N) of two bodies of effective mass m_star (kg) at v_rel (m/s);
+/// the physical arguments first and the law after them, as in
+/// `demfem.contact.max_contact_force(a, b, v_rel, model)`.
 #[pyfunction]
-#[pyo3(signature = (law, m_star, v_rel, k_h=f64::NAN, k_r=f64::NAN, k=f64::NAN))]
+#[pyo3(signature = (m_star, v_rel, model, k_h=f64::NAN, k_r=f64::NAN, k=f64::NAN))]
 fn max_impact_force(
-    law: &str,
     m_star: f64,
     v_rel: f64,
+    model: &str,
     k_h: f64,
     k_r: f64,
     k: f64,
 ) -> PyResult<f64> {
     contact_checks(m_star, v_rel)?;
-    Ok(match parse_law(law, k_h, k_r, k)? {
+    Ok(match parse_law(model, k_h, k_r, k)? {
         NormalLaw::Hertz { k_h } => contact::max_force_hertz(k_h, m_star, v_rel),
         NormalLaw::Linear { k } => contact::max_force_linear(k, m_star, v_rel),
         NormalLaw::HertzReissner { k_h, k_r } => {
@@ -190,15 +310,20 @@ fn tsuji_damping_for_restitution(py: Python<'_>, e: f64, clamp: bool) -> PyResul
         .map_err(PyDemfemError::from)?)
 }
 
-/// Rayleigh time step (s) of a sphere of radius (m), density (kg/m^3), E (Pa), nu.
+/// Rayleigh time step (s) of a sphere of radius (m), E (Pa), nu and density (kg/m^3): the
+/// argument order and names of `demfem.contact.rayleigh_time_step`.
 #[pyfunction]
-fn rayleigh_time_step(radius: f64, density: f64, e: f64, nu: f64) -> PyResult<f64> {
-    Ok(contact::rayleigh_time_step(radius, density, e, nu).map_err(PyDemfemError::from)?)
+#[allow(non_snake_case)]
+#[pyo3(signature = (radius, E, nu, density))]
+fn rayleigh_time_step(radius: f64, E: f64, nu: f64, density: f64) -> PyResult<f64> {
+    Ok(contact::rayleigh_time_step(radius, density, E, nu).map_err(PyDemfemError::from)?)
 }
 
-/// Duration (s) of an undamped Hertz impact.
+/// Duration (s) of an undamped Hertz impact of stiffness k_h (N/m^1.5) and effective mass
+/// m_star (kg) at v_rel (m/s). (`demfem.contact.hertz_contact_duration(a, b, v_rel)` takes
+/// two bodies; this one, like `max_impact_force`, takes the pair's stiffness and mass.)
 #[pyfunction]
-fn hertz_contact_duration(k_h: f64, m_star: f64, v_rel: f64) -> PyResult<f64> {
+fn hertz_impact_duration(k_h: f64, m_star: f64, v_rel: f64) -> PyResult<f64> {
     demfem::error::check_positive("k_h", k_h).map_err(PyDemfemError::from)?;
     demfem::error::check_positive("m_star", m_star).map_err(PyDemfemError::from)?;
     Ok(contact::hertz_contact_duration(k_h, m_star, v_rel).map_err(PyDemfemError::from)?)
@@ -212,7 +337,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(tsuji_restitution, m)?)?;
     m.add_function(wrap_pyfunction!(tsuji_damping_for_restitution, m)?)?;
     m.add_function(wrap_pyfunction!(rayleigh_time_step, m)?)?;
-    m.add_function(wrap_pyfunction!(hertz_contact_duration, m)?)?;
+    m.add_function(wrap_pyfunction!(hertz_impact_duration, m)?)?;
     dem::register(m)?;
     fem::register(m)?;
     rigid::register(m)?;

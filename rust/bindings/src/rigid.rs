@@ -312,7 +312,9 @@ impl RigidSimulation {
     /// Advance `n` steps, releasing the GIL in chunks of `chunk` steps; Ctrl-C between chunks
     /// raises SimulationInterrupted with the state consistent at a step boundary.
     #[pyo3(signature = (n, chunk=2000))]
-    fn step(&mut self, py: Python<'_>, n: u64, chunk: u64) -> PyResult<()> {
+    fn step(&mut self, py: Python<'_>, n: i64, chunk: i64) -> PyResult<()> {
+        let n = crate::dem::checked_steps(n, self.scene.time(), self.scene.time_step())?;
+        let chunk = crate::count("chunk", chunk)?;
         crate::run_in_chunks(
             py,
             &mut self.scene,
@@ -326,9 +328,12 @@ impl RigidSimulation {
 
     /// Advance until the simulated time reaches `t_end` (s); returns the steps taken.
     #[pyo3(signature = (t_end, chunk=2000))]
-    fn run_until(&mut self, py: Python<'_>, t_end: f64, chunk: u64) -> PyResult<u64> {
+    fn run_until(&mut self, py: Python<'_>, t_end: f64, chunk: i64) -> PyResult<u64> {
         let n = crate::steps_until(t_end, self.scene.time(), self.scene.time_step())?;
-        self.step(py, n, chunk)?;
+        let steps = i64::try_from(n).map_err(|_| {
+            crate::dem::invalid("t_end", &t_end.to_string(), "reachable in < 2^63 steps")
+        })?;
+        self.step(py, steps, chunk)?;
         Ok(n)
     }
 
