@@ -20,7 +20,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from demfem.errors import InvalidParameterError, check_positive, check_range
+from demfem.errors import InvalidParameterError, as_real, check_positive, check_range
 
 if TYPE_CHECKING:
     from demfem.cartridge import Cartridge
@@ -137,7 +137,7 @@ class ContactBody:
 
     def __post_init__(self) -> None:
         for name in ("mass", "radius", "E"):
-            v = float(getattr(self, name))
+            v = as_real(name, getattr(self, name))
             if not (math.isinf(v) and v > 0):
                 check_positive(name, v)
             object.__setattr__(self, name, v)

@@ -69,9 +69,16 @@ __all__ = [
     "check_range",
     "check_positive",
     "check_count",
+    "as_real",
     "CheckpointError",
     "SettingsMismatchError",
 ]
+
+
+def as_real(field: str, value: Any) -> float:
+    """``value`` as a float (may be inf or NaN); booleans and non-numbers raise
+    :class:`InvalidParameterError` naming ``field``."""
+    return _as_float(field, value)
 
 
 def _as_float(field: str, value: Any) -> float:

@@ -475,8 +475,11 @@ def checkpoint_state(ckpt: str | Path) -> Optional[dict[str, Any]]:
     try:
         state = json.loads(meta.read_text(encoding="utf-8"))
         if not isinstance(state, dict) or not {"settings", "sha256", "sim_time_s",
-                                               "wall_time_s"} <= set(state):
+                                               "wall_time_s", "checksum"} <= set(state):
             raise ValueError("missing keys")
+        body = {k: v for k, v in state.items() if k != "checksum"}
+        if _meta_checksum(body) != state["checksum"]:
+            raise ValueError("its checksum does not match its content (altered)")
     except (OSError, UnicodeDecodeError, ValueError) as exc:
         raise CheckpointError(f"damaged checkpoint file {meta}: {exc}; start afresh "
                               "(fresh=True, demfem run --fresh)") from None
@@ -544,12 +547,19 @@ def _write_checkpoint(sim, rec: _Recorder, files: tuple[Path, Path, Path],
     new_engine, new_record = _new_files(ckpt)
     sim.save_checkpoint(new_engine)
     rec.save_partial(new_record)
-    write_json_atomic(meta, {"format": 2, "settings": dict(settings), "wall_time_s": wall_time,
-                             "sim_time_s": float(sim.time),
-                             "sha256": {"engine": sha256_file(new_engine),
-                                        "record": sha256_file(new_record)}})
+    body = {"format": 2, "settings": dict(settings), "wall_time_s": wall_time,
+            "sim_time_s": float(sim.time),
+            "sha256": {"engine": sha256_file(new_engine), "record": sha256_file(new_record)}}
+    write_json_atomic(meta, {**body, "checksum": _meta_checksum(body)})
     os.replace(new_engine, ckpt)
     os.replace(new_record, record_file)
+
+
+def _meta_checksum(body: Mapping[str, Any]) -> str:
+    """SHA-256 of a checkpoint metadata's content (canonical strict JSON, sorted keys)."""
+    import hashlib
+
+    return hashlib.sha256(json_dumps(body, sort_keys=True).encode("utf-8")).hexdigest()
 
 
 def _belt_plane(scene) -> Optional[tuple[np.ndarray, np.ndarray]]:

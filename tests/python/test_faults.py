@@ -1,0 +1,241 @@
+"""No silent garbage: bad input raises an error naming the field, a broken run raises
+NumericalError, a checkpoint from other settings or a damaged one is refused by name."""
+from __future__ import annotations
+
+import json
+import math
+import time
+
+import numpy as np
+import pytest
+
+from demfem import _core, dem
+from demfem.errors import (CheckpointError, InvalidParameterError, NumericalError,
+                           SettingsMismatchError, SimulationInterrupted, check_count)
+from demfem.scenes.table import AccumulationTable
+from demfem.studies.table_run import checkpoint_files, run_table
+
+R = 0.008
+GLASS = dem.material(45e9, 0.22, 2230.0)  # frictionless, elastic: effect "gravity" only
+TINY = dict(width=0.1, length=0.1, tilted_wall_length=0.08, opening_width=0.03,
+            gate_amplitude=0.01, gate_period=0.2, belt_velocity=0.5, young_modulus=1e7,
+            n_spheres=30)
+
+
+def one_sphere(**kw):
+    return dem.DemSimulation(np.array([[0.0, 0.0, R]]), np.array([R]), [GLASS], [],
+                             ["gravity"], **kw)
+
+
+# ---- numbers that are not what they seem --------------------------------------------------
+
+def test_booleans_are_refused_for_numeric_fields():
+    from demfem.contact import ContactBody
+    from demfem.materials import Material
+
+    with pytest.raises(InvalidParameterError, match="invalid E = True.*boolean"):
+        Material(E=True, nu=0.22, density=2230.0)
+    with pytest.raises(InvalidParameterError, match="radius"):
+        ContactBody(mass=1.0, radius=True, E=1e9, nu=0.2)
+    with pytest.raises(InvalidParameterError, match="n_spheres"):
+        check_count("n_spheres", True)
+    assert check_count("n_spheres", np.int64(3)) == 3
+
+
+@pytest.mark.parametrize("call, field", [
+    (lambda: one_sphere().step(-1), "invalid n = -1"),
+    (lambda: one_sphere().step(10, chunk=-5), "invalid chunk = -5"),
+    (lambda: one_sphere(threads=-1), "invalid threads = -1"),
+    (lambda: one_sphere(threads=0), "invalid threads = 0"),
+    (lambda: one_sphere(record_every=-1), "invalid record_every = -1"),
+])
+def test_negative_counts_name_the_field(call, field):
+    with pytest.raises(InvalidParameterError, match=field):
+        call()
+
+
+def test_arrays_of_another_dtype_are_converted_or_named():
+    sim = dem.DemSimulation(np.array([[0, 0, 1]]), np.array([1]), [GLASS], [], ["gravity"],
+                            tags=np.array([3], np.int32), dt=1e-6)
+    assert sim.positions().dtype == np.float64 and sim.radii()[0] == 1.0
+    assert sim.tags()[0] == 3
+    with pytest.raises(InvalidParameterError, match="positions"):
+        dem.DemSimulation([["a", "b", "c"]], np.array([R]), [GLASS], [], ["gravity"])
+    with pytest.raises(InvalidParameterError, match="tags"):
+        one_sphere(tags=np.array([1.5]))
+    with pytest.raises(InvalidParameterError, match="material_ids"):
+        one_sphere(material_ids=np.array([0.0]))
+
+
+def test_a_tiny_impact_speed_is_refused_not_divided_by_zero():
+    from demfem.cartridge import Cartridge
+    from demfem.contact import ContactBody, hertz_contact_duration, max_contact_force
+
+    body = ContactBody.from_cartridge(Cartridge())
+    for f in (max_contact_force, hertz_contact_duration):
+        with pytest.raises(InvalidParameterError, match=r"v_rel = 1e-200.*\[1e-12, inf\)"):
+            f(body, body, 1e-200)
+    assert max_contact_force(body, body, 0.0) == 0.0
+
+
+def test_core_normal_force_refuses_non_finite_overlaps():
+    with pytest.raises(InvalidParameterError, match=r"overlap\[1\]"):
+        _core.normal_force(np.array([0.0, np.nan]), "hertz", k_h=1e9)
+    with pytest.raises(InvalidParameterError, match=r"overlap\[0\]"):
+        _core.normal_force(np.array([np.inf]), "linear", k=1e3)
+    f, _ = _core.normal_force(np.array([1, 2]), "linear", k=10.0)  # integers are converted
+    np.testing.assert_array_equal(f, [10.0, 20.0])
+
+
+def test_an_empty_simulation_refuses_an_absurd_step():
+    empty = (np.zeros((0, 3)), np.zeros(0), [GLASS], [], ["gravity"])
+    with pytest.raises(InvalidParameterError, match="dt"):
+        dem.DemSimulation(*empty, dt=3.6e307)
+    with pytest.raises(InvalidParameterError, match="dt"):
+        dem.DemSimulation(*empty, dt=math.inf)
+    sim = dem.DemSimulation(*empty, dt=1.0)  # the largest step accepted
+    sim.step(3)
+    assert sim.time == 3.0
+
+
+# ---- Ctrl-C whatever the chunk ------------------------------------------------------------
+
+def test_ctrl_c_is_seen_within_a_second_even_with_one_huge_chunk():
+    import _thread
+    import threading
+
+    sim = dem.DemSimulation.anchor_table(1e8, start="square")
+    timer = threading.Timer(0.3, _thread.interrupt_main)
+    start = time.perf_counter()
+    timer.start()
+    with pytest.raises(SimulationInterrupted):
+        sim.step(10**9, chunk=10**9)
+    timer.cancel()
+    assert time.perf_counter() - start < 1.5
+    assert 0 < sim.steps < 10**9 and np.isfinite(sim.positions()).all()
+
+
+def test_slicing_a_chunk_does_not_change_the_result():
+    a = dem.DemSimulation.anchor_table(1e8, start="packed")
+    b = dem.DemSimulation.anchor_table(1e8, start="packed")
+    a.step(600, chunk=600)
+    for _ in range(200):
+        b.step(3, chunk=1)
+    np.testing.assert_array_equal(a.positions(), b.positions())
+    np.testing.assert_array_equal(a.velocities(), b.velocities())
+
+
+# ---- physical sanity ----------------------------------------------------------------------
+
+def test_a_modulus_too_low_for_the_load_raises_numerical_error():
+    with pytest.raises(NumericalError, match="Young's modulus too low") as exc:
+        run_table(AccumulationTable(**{**TINY, "young_modulus": 1e3}), 0.2,
+                  sample_interval=0.02)
+    assert "belt" in str(exc.value) or "max_overlap" in str(exc.value)
+
+
+def test_check_state_passes_a_sound_state_and_names_a_deep_overlap():
+    sim = one_sphere(dt=1e-6)
+    dem.check_state(sim, floor=((0, 0, 0), (0, 0, 1)))  # resting on the floor: fine
+    sunk = dem.DemSimulation(np.array([[0.0, 0.0, 0.5 * R]]), np.array([R]), [GLASS], [],
+                             ["gravity"], dt=1e-6)
+    with pytest.raises(NumericalError, match="sphere 0 has sunk"):
+        dem.check_state(sunk, floor=((0, 0, 0), (0, 0, 1)))
+    with pytest.raises(InvalidParameterError, match="overlap_fraction"):
+        dem.check_state(sim, overlap_fraction=2.0)
+
+
+# ---- checkpoints --------------------------------------------------------------------------
+
+class _Stop(Exception):
+    pass
+
+
+def _interrupted_run(ckpt, **kw):
+    def stop(sim_time, steps):
+        if sim_time > 0.1:
+            raise _Stop
+
+    with pytest.raises(_Stop):
+        run_table(AccumulationTable(**TINY), 0.4, sample_interval=0.02, checkpoint=ckpt,
+                  checkpoint_every=1e-9, progress=stop, **kw)
+
+
+def test_checkpoint_records_settings_and_checksums(tmp_path):
+    ckpt = tmp_path / "run.ckpt"
+    _interrupted_run(ckpt)
+    meta = json.loads(checkpoint_files(ckpt)[2].read_text())
+    assert meta["settings"]["duration_s"] == 0.4
+    assert meta["settings"]["sample_interval_s"] == 0.02
+    assert meta["settings"]["scene"]["young_modulus"] == 1e7
+    assert set(meta["sha256"]) == {"engine", "record"}
+    assert all(len(h) == 64 for h in meta["sha256"].values())
+
+
+@pytest.mark.parametrize("kw, named", [
+    ({"duration": 0.3}, "duration_s: 0.4 -> 0.3"),
+    ({"sample_interval": 0.04}, "sample_interval_s: 0.02 -> 0.04"),
+])
+def test_resume_with_other_settings_is_refused_naming_them(tmp_path, kw, named):
+    ckpt = tmp_path / "run.ckpt"
+    _interrupted_run(ckpt)
+    args = {"duration": 0.4, "sample_interval": 0.02, **kw}
+    with pytest.raises(SettingsMismatchError, match=named) as exc:
+        run_table(AccumulationTable(**TINY), args["duration"],
+                  sample_interval=args["sample_interval"], checkpoint=ckpt)
+    assert "fresh" in str(exc.value)
+    run = run_table(AccumulationTable(**TINY), args["duration"],
+                    sample_interval=args["sample_interval"], checkpoint=ckpt, fresh=True)
+    assert math.isclose(run.times[-1], args["duration"], abs_tol=1e-4)
+
+
+@pytest.mark.parametrize("which", [0, 1, 2])
+@pytest.mark.parametrize("damage", ["truncate", "flip"])
+def test_a_damaged_checkpoint_is_refused_naming_the_file(tmp_path, which, damage):
+    ckpt = tmp_path / "run.ckpt"
+    _interrupted_run(ckpt)
+    path = checkpoint_files(ckpt)[which]
+    data = bytearray(path.read_bytes())
+    if damage == "truncate":
+        data = data[: len(data) // 2]
+    else:
+        data[len(data) // 2] ^= 0x10
+    path.write_bytes(bytes(data))
+    with pytest.raises(CheckpointError, match=path.name):
+        run_table(AccumulationTable(**TINY), 0.4, sample_interval=0.02, checkpoint=ckpt)
+
+
+# ---- files --------------------------------------------------------------------------------
+
+def test_strict_json_has_no_nan_or_infinity():
+    from demfem.io import json_dumps
+
+    text = json_dumps({"a": math.nan, "b": [math.inf, -math.inf, 1.5],
+                       "c": np.float64("nan"), "d": np.arange(2)})
+    assert json.loads(text) == {"a": None, "b": [None, None, 1.5], "c": None, "d": [0, 1]}
+    assert "NaN" not in text and "Infinity" not in text
+
+
+def test_stale_temporaries_are_cleaned(tmp_path):
+    from demfem.io import clean_stale_temporaries
+
+    (tmp_path / "vtk").mkdir()
+    stale = [tmp_path / ".summary.json.abc123.tmp", tmp_path / "vtk" / ".t.vtp.x1.tmp.vtp"]
+    for p in stale:
+        p.write_text("half")
+    keep = tmp_path / "summary.json"
+    keep.write_text("{}")
+    assert sorted(clean_stale_temporaries(tmp_path)) == sorted(stale)
+    assert keep.exists() and not any(p.exists() for p in stale)
+
+
+def test_a_vtk_series_replaces_the_old_frames(tmp_path):
+    from demfem.io import write_vtk_series
+
+    run = run_table(AccumulationTable(**TINY), 0.1, sample_interval=0.02)
+    write_vtk_series(tmp_path, run, 0.02)
+    assert len(list(tmp_path.glob("table_*.vtp"))) == 6
+    write_vtk_series(tmp_path, run, 0.04)
+    assert len(list(tmp_path.glob("table_*.vtp"))) == 3
+    listed = (tmp_path / "table.pvd").read_text().count("<DataSet")
+    assert listed == 3
