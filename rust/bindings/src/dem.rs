@@ -36,22 +36,42 @@ pub(crate) fn invalid(field: &str, value: &str, allowed: &str) -> PyErr {
 pub(crate) const MAX_DT: f64 = 1.0;
 
 /// A converted array (see [`crate::as_float_array`]) as a 2-D float64 view.
-pub(crate) fn float2<'py>(a: &Bound<'py, PyAny>, field: &str) -> PyResult<PyReadonlyArray2<'py, f64>> {
+pub(crate) fn float2<'py>(
+    a: &Bound<'py, PyAny>,
+    field: &str,
+) -> PyResult<PyReadonlyArray2<'py, f64>> {
     a.extract().map_err(|_| {
-        shape_err(field, format!("expected a 2-D array (N, 3), got {} dimensions", ndim(a)))
+        shape_err(
+            field,
+            format!("expected a 2-D array (N, 3), got {} dimensions", ndim(a)),
+        )
     })
 }
 
 /// A converted array as a 1-D float64 view.
-pub(crate) fn float1<'py>(a: &Bound<'py, PyAny>, field: &str) -> PyResult<PyReadonlyArray1<'py, f64>> {
-    a.extract()
-        .map_err(|_| shape_err(field, format!("expected a 1-D array, got {} dimensions", ndim(a))))
+pub(crate) fn float1<'py>(
+    a: &Bound<'py, PyAny>,
+    field: &str,
+) -> PyResult<PyReadonlyArray1<'py, f64>> {
+    a.extract().map_err(|_| {
+        shape_err(
+            field,
+            format!("expected a 1-D array, got {} dimensions", ndim(a)),
+        )
+    })
 }
 
 /// A converted integer array as a 1-D int64 view.
-pub(crate) fn int1<'py>(a: &Bound<'py, PyAny>, field: &str) -> PyResult<PyReadonlyArray1<'py, i64>> {
-    a.extract()
-        .map_err(|_| shape_err(field, format!("expected a 1-D array, got {} dimensions", ndim(a))))
+pub(crate) fn int1<'py>(
+    a: &Bound<'py, PyAny>,
+    field: &str,
+) -> PyResult<PyReadonlyArray1<'py, i64>> {
+    a.extract().map_err(|_| {
+        shape_err(
+            field,
+            format!("expected a 1-D array, got {} dimensions", ndim(a)),
+        )
+    })
 }
 
 fn ndim(a: &Bound<'_, PyAny>) -> usize {
@@ -308,7 +328,11 @@ impl DemSimulation {
         removal_plane: Option<((f64, f64, f64), (f64, f64, f64))>,
     ) -> PyResult<Self> {
         if threads < 1 {
-            return Err(invalid("threads", &threads.to_string(), "a whole number >= 1"));
+            return Err(invalid(
+                "threads",
+                &threads.to_string(),
+                "a whole number >= 1",
+            ));
         }
         let threads = usize::try_from(threads)
             .map_err(|_| invalid("threads", &threads.to_string(), "a whole number >= 1"))?;
@@ -498,7 +522,8 @@ impl DemSimulation {
     #[pyo3(signature = (t_end, chunk=2000))]
     fn run_until(&mut self, py: Python<'_>, t_end: f64, chunk: i64) -> PyResult<u64> {
         let n = crate::steps_until(t_end, self.sim.time(), self.sim.dt())?;
-        let steps = i64::try_from(n).map_err(|_| invalid("t_end", &t_end.to_string(), "reachable in < 2^63 steps"))?;
+        let steps = i64::try_from(n)
+            .map_err(|_| invalid("t_end", &t_end.to_string(), "reachable in < 2^63 steps"))?;
         self.step(py, steps, chunk)?;
         Ok(n)
     }

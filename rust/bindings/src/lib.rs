@@ -134,7 +134,10 @@ pub(crate) fn as_float_array<'py>(
 
 /// An integer input array converted to int64 (any integer dtype accepted); anything else
 /// raises InvalidParameterError naming `field`.
-pub(crate) fn as_int_array<'py>(obj: &Bound<'py, PyAny>, field: &str) -> PyResult<Bound<'py, PyAny>> {
+pub(crate) fn as_int_array<'py>(
+    obj: &Bound<'py, PyAny>,
+    field: &str,
+) -> PyResult<Bound<'py, PyAny>> {
     let py = obj.py();
     let np = py.import("numpy")?;
     let arr = np.call_method1("asarray", (obj,)).map_err(|_| {
@@ -233,7 +236,10 @@ fn normal_force<'py>(
             field: "overlap".into(),
             detail: format!(
                 "expected a 1-D array, got {} dimensions",
-                overlap.getattr("ndim").and_then(|d| d.extract::<usize>()).unwrap_or(0)
+                overlap
+                    .getattr("ndim")
+                    .and_then(|d| d.extract::<usize>())
+                    .unwrap_or(0)
             ),
         }))
     })?;
