@@ -1,0 +1,107 @@
+"""The self-contained HTML report of an assessment: one file, figures embedded as base64
+PNG, no external resources (no scripts, style sheets or fonts from elsewhere)."""
+from __future__ import annotations
+
+import base64
+import html
+import math
+from typing import Any
+
+__all__ = ["render_report"]
+
+_CSS = ("body{font-family:sans-serif;max-width:980px;margin:2em auto;color:#222}"
+        "table{border-collapse:collapse;margin:0.6em 0}td,th{border:1px solid #bbb;"
+        "padding:3px 8px;text-align:left;font-size:0.92em}th{background:#eee}"
+        ".warn{background:#fff3cd;border:1px solid #e0c36c;padding:0.5em}"
+        "figure{margin:1em 0}figcaption{font-size:0.9em;color:#444}")
+
+
+def _n(x: Any, digits: int = 3) -> str:
+    if x is None:
+        return "n/a"
+    if isinstance(x, bool):
+        return "yes" if x else "no"
+    if isinstance(x, int):
+        return str(x)
+    if isinstance(x, float):
+        if not math.isfinite(x):
+            return "n/a"
+        return f"{x:.{digits}g}"
+    return html.escape(str(x))
+
+
+def _table(rows: list[tuple[str, Any]], head: tuple[str, str] = ("quantity", "value"),
+           cls: str = "") -> str:
+    body = "".join(f"<tr><td>{html.escape(k)}</td><td>{_n(v)}</td></tr>" for k, v in rows)
+    return (f"<table class='{cls}'><tr><th>{head[0]}</th><th>{head[1]}</th></tr>{body}"
+            "</table>")
+
+
+def render_report(risk: dict[str, Any], figures: dict[str, bytes],
+                  captions: dict[str, str]) -> str:
+    """The report's HTML text from the risk document (``risk.json``'s content), the figures
+    ({file name: PNG bytes}) and their captions."""
+    s = risk["summary"]
+    st = risk["steady_state"]
+    parts = ["<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
+             "<title>demfem assess: breakage risk of the accumulation table</title>",
+             f"<style>{_CSS}</style></head><body>",
+             "<h1>Breakage risk of glass cartridges on the accumulation table</h1>",
+             "<p>demfem assess: calibration &rarr; DEM of the table &rarr; collision events "
+             "&rarr; stress model &rarr; Weibull risk. SI units throughout.</p>"]
+    for w in risk["warnings"]:
+        parts.append(f"<p class='warn'>{html.escape(w)}</p>")
+    parts.append("<h2>Summary</h2>")
+    parts.append(_table([
+        ("statistics window, s", f"{st['window_s'][0]:.4g} – {st['window_s'][1]:.4g}"),
+        ("cartridges on the table (mean over the window)", s["mean_on_table"]),
+        ("impact events in the window (normal speed ≥ min speed)", s["n_events_window"]),
+        ("collision rate, events/s", s["event_rate_per_s"]),
+        ("P per cartridge over the window: mean", s["p_window_mean"]),
+        ("P per cartridge over the window: max", s["p_window_max"]),
+        ("residence time on the table (Little's law), s", s["residence_time_s"]),
+        ("P per passage: mean", s["p_passage_mean"]),
+        ("P per passage: max", s["p_passage_max"]),
+        ("throughput (planning assumption), cartridges/h", s["throughput_per_hour"]),
+        ("expected broken per hour, 1/h", s["broken_per_hour"]),
+        ("share of the hazard from the inner surface", s["inner_share"]),
+        ("largest peak contact force in the window, N", s["max_force_N"]),
+        ("largest inner σ1 in the window, Pa", s["max_sigma_inner_Pa"]),
+        ("largest outer σ1 in the window, Pa", s["max_sigma_outer_Pa"]),
+    ], cls="summary"))
+    parts.append("<h2>Worst collisions</h2><table><tr><th>event</th><th>cartridges</th>"
+                 "<th>time, s</th><th>x, y, m</th><th>v_n, m/s</th><th>F, N</th>"
+                 "<th>σ1 inner, MPa</th><th>σ1 outer, MPa</th><th>P_k</th></tr>")
+    for r in risk["worst_events"]:
+        parts.append(f"<tr><td>{r['event']}</td><td>{r['i']} – {r['j']} ({r['partner']})</td>"
+                     f"<td>{r['time_s']:.4g}</td><td>{r['x_m']:.3f}, {r['y_m']:.3f}</td>"
+                     f"<td>{r['normal_speed_m_per_s']:.3g}</td><td>{r['force_N']:.3g}</td>"
+                     f"<td>{r['sigma_inner_Pa'] / 1e6:.3g}</td>"
+                     f"<td>{r['sigma_outer_Pa'] / 1e6:.3g}</td><td>{r['p_event']:.3g}</td></tr>")
+    parts.append("</table>")
+    parts.append("<h2>Steady state</h2>")
+    parts.append(f"<p>Statistics are taken over t = {st['window_s'][0]:.4g} – "
+                 f"{st['window_s'][1]:.4g} s (the first {st['window_s'][0]:.4g} s are "
+                 "discarded as the transient in which the pack forms). Collision rate in the "
+                 f"first half of the window {_n(st['rate_first_half_per_s'])}/s, in the second "
+                 f"{_n(st['rate_second_half_per_s'])}/s (ratio {_n(st['rate_ratio'])}, Poisson "
+                 f"z = {_n(st['poisson_z'])}: "
+                 + ("no drift detectable" if st["steady"] else "the rate drifts: the window is "
+                    "not yet steady, lengthen the run") + "); hazard ratio second/first half "
+                 f"{_n(st['hazard_ratio'])}.</p>")
+    parts.append("<h2>Figures</h2>")
+    for name, png in figures.items():
+        b64 = base64.b64encode(png).decode("ascii")
+        parts.append(f"<figure><img src=\"data:image/png;base64,{b64}\" alt=\"{name}\" "
+                     f"style='max-width:100%'><figcaption>{html.escape(captions.get(name, name))}"
+                     "</figcaption></figure>")
+    parts.append("<h2>What the numbers rest on</h2><ul>")
+    for line in risk["basis"]:
+        parts.append(f"<li>{html.escape(line)}</li>")
+    parts.append("</ul><h2>Settings</h2>")
+    parts.append(_table([(k, v if not isinstance(v, (dict, list)) else str(v))
+                         for k, v in risk["settings_flat"].items()], ("setting", "value")))
+    parts.append("<p>Files: risk.json (strict JSON), events.csv (one row per event), "
+                 "cartridges.csv (one row per cartridge), stages.json (stage record), "
+                 "the figures as PNG.</p></body></html>")
+    return "\n".join(parts)

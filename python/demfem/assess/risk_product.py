@@ -1,0 +1,147 @@
+"""The risk stage's products: ``risk.json`` (strict JSON), ``events.csv``,
+``cartridges.csv`` and ``risk_arrays.npz`` (the arrays the figures are drawn from), with the
+statement of what each number rests on (``basis``) and the warnings of the report."""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any, Optional
+
+import numpy as np
+
+from demfem.assess.risk_stage import (cartridge_risk, event_probabilities, risk_map,
+                                      steady_state, worst_events)
+
+__all__ = ["risk_document"]
+
+
+def _basis(model, scg, ev_summary: dict[str, Any], e_stress: float, table) -> list[str]:
+    from demfem.risk import INNER_SURFACE, OUTER_SURFACE
+
+    lines = [
+        "Impact speeds: the DEM of the table (equivalent spheres, Hertz-Reissner-Mindlin "
+        f"contacts, E = {table.young_modulus:.3g} Pa); every contact onset with normal speed "
+        f">= {ev_summary['min_speed_m_per_s']:g} m/s is an event "
+        f"({ev_summary['n_dropped']} slower onsets dropped, the fastest of them at "
+        f"{ev_summary['max_dropped_speed_m_per_s']:.3g} m/s). {ev_summary['note']}.",
+        "Peak force: the calibrated Hertz-Reissner law (paper eq. 12, demfem.contact."
+        f"max_contact_force) at E = {e_stress:.3g} Pa for the default 3 mL cartridge's "
+        "equivalent body; the DEM's restitution (damping) is not applied to the peak "
+        "(undamped, an upper bound).",
+        f"Stress model: sigma1 = beta F/t^2 with beta_inner = {model.beta_inner:.4g}, "
+        f"beta_outer = {model.beta_outer:.4g}, t = {model.thickness:g} m; stressed areas "
+        f"{model.area_factor_inner:.4g} (inner) and {model.area_factor_outer:.4g} (outer) "
+        f"times the Hertz patch pi a^2. Source: {model.source}. A constant beta misses the "
+        "closed form's ln(1/a) growth by about +-20 % over the DEM's force range; the "
+        "cylinder (not a sphere) bends more; refit from FEM runs (StressModel.fit) before "
+        "trusting absolute values.",
+        "Weibull strength (planning assumptions, NOT measured on any product): inner m = "
+        f"{INNER_SURFACE.weibull_modulus:g}, sigma_0 = {INNER_SURFACE.characteristic_strength:.3g}"
+        f" Pa; outer m = {OUTER_SURFACE.weibull_modulus:g}, sigma_0 = "
+        f"{OUTER_SURFACE.characteristic_strength:.3g} Pa; A_0 = "
+        f"{INNER_SURFACE.reference_area:g} m^2 ({INNER_SURFACE.source}; {OUTER_SURFACE.source})."
+        " With m = 6-10, a 20 % change of sigma_0 changes P by a factor 3-9: the absolute "
+        "probabilities are uncertain by orders of magnitude, their ratios between table "
+        "settings much less.",
+        ("Slow crack growth: half-sine pulse of the contact duration, equivalent static "
+         f"stress over t_ref = {scg.reference_time:g} s with n = {scg.crack_growth_exponent:g} "
+         f"({scg.source})." if scg is not None else
+         "Slow crack growth: off (the peak stress acts as if held over the strength test)."),
+        "Combination: collisions and surfaces independent, P = 1 - prod(1 - P_k) "
+        "(conservative for repeated hits on one spot); both cartridges of a collision get "
+        "their own P_k.",
+        "Per hour: hazard rate per cartridge over the window, residence time by Little's law "
+        "(mean number on the table / throughput); for small P the hourly number is 3600 x "
+        "the summed hazard rate of the simulated population, independent of the throughput "
+        "as long as the table holds that population.",
+    ]
+    return lines
+
+
+def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[str, Any],
+                  stress: dict[str, np.ndarray], model, scg, window: tuple[float, float],
+                  throughput: float, settings: dict[str, Any],
+                  e_stress: float) -> list[Path]:
+    """Compute the risk stage and write its files into ``out``; returns their paths."""
+    from demfem.assess.events import write_events_csv
+    from demfem.assess.run import _flatten, _save_npz
+    from demfem.io.atomic import write_text_atomic
+    from demfem.io.strict_json import write_json_atomic
+    from demfem.materials import PAPER_GLASS
+    from demfem.risk import INNER_SURFACE, OUTER_SURFACE
+
+    p = event_probabilities(stress, INNER_SURFACE, OUTER_SURFACE, scg)
+    n = run.n_particles
+    cr = cartridge_risk(events, p["p_event"], n, run.removal_times, window, throughput)
+    steady = steady_state(events, p["p_event"], window)
+    worst = worst_events(events, p, stress, window)
+    pos = run.positions[np.isfinite(run.positions[..., 0])]
+    pad = float(np.max(run.radii))
+    extent = (float(pos[:, 0].min()) - pad, float(pos[:, 0].max()) + pad,
+              float(pos[:, 1].min()) - pad, float(pos[:, 1].max()) + pad)
+    rmap = risk_map(events, p["p_event"], window, extent)
+    inside = (events["time"] >= window[0]) & (events["time"] <= window[1])
+    h_in = float(-np.log1p(-p["p_inner"][inside]).sum())
+    h_out = float(-np.log1p(-p["p_outer"][inside]).sum())
+    present = cr["exposure_s"] > 0
+    w = cr["window_s"]
+
+    def mx(a: np.ndarray) -> Optional[float]:
+        return float(np.max(a)) if a.size else None
+
+    summary = {
+        "n_events_window": int(inside.sum()),
+        "event_rate_per_s": float(inside.sum() / w) if w > 0 else math.nan,
+        "mean_on_table": cr["mean_on_table"], "residence_time_s": cr["residence_time_s"],
+        "p_window_mean": float(np.mean(cr["p_window"][present])) if present.any() else 0.0,
+        "p_window_max": float(np.max(cr["p_window"])),
+        "p_passage_mean": float(np.mean(cr["p_passage"][present])) if present.any() else 0.0,
+        "p_passage_max": float(np.max(cr["p_passage"])),
+        "throughput_per_hour": throughput, "broken_per_hour": cr["broken_per_hour"],
+        "broken_per_hour_small_p": cr["broken_per_hour_small_p"],
+        "inner_share": h_in / (h_in + h_out) if h_in + h_out > 0 else math.nan,
+        "max_force_N": mx(stress["force_N"][inside]),
+        "max_sigma_inner_Pa": mx(stress["sigma_inner_Pa"][inside]),
+        "max_sigma_outer_Pa": mx(stress["sigma_outer_Pa"][inside]),
+    }
+    warnings = []
+    if table.young_modulus < PAPER_GLASS.E:
+        warnings.append(f"The DEM runs at a reduced Young's modulus E = "
+                        f"{table.young_modulus:.3g} Pa (glass: {PAPER_GLASS.E:.3g} Pa): the "
+                        "impact speeds come from a softer table; the forces are evaluated at "
+                        f"E = {e_stress:.3g} Pa.")
+    if not steady["steady"]:
+        warnings.append("The collision rate drifts across the statistics window (Poisson "
+                        f"z = {steady['poisson_z']:.2f}): the window is not a steady state; "
+                        "run longer or discard more.")
+    if w < 0.5:
+        warnings.append(f"Short statistics window ({w:.3g} s, less than a quarter of the "
+                        "gate period of the default table): a smoke run, not an assessment.")
+    doc = {"format": 1, "summary": summary, "steady_state": steady, "worst_events": worst,
+           "events": ev_summary, "warnings": warnings,
+           "basis": _basis(model, scg, ev_summary, e_stress, table),
+           "window_s": list(window), "settings": settings,
+           "settings_flat": {k: v for k, v in _flatten(settings).items()
+                             if not k.startswith("stress_model.units")}}
+    files = [write_json_atomic(out / "risk.json", doc)]
+    extra = {"force_N": stress["force_N"], "contact_radius_m": stress["contact_radius_m"],
+             "duration_s": stress["duration_s"], "sigma_inner_Pa": stress["sigma_inner_Pa"],
+             "sigma_outer_Pa": stress["sigma_outer_Pa"],
+             "area_inner_m2": stress["area_inner_m2"], "area_outer_m2": stress["area_outer_m2"],
+             "p_inner": p["p_inner"], "p_outer": p["p_outer"], "p_event": p["p_event"],
+             "in_window": inside}
+    write_events_csv(out / "events.csv", events, extra)
+    files.append(out / "events.csv")
+    head = ("cartridge,tag,n_events_window,exposure_s,removal_time_s,p_window,"
+            "hazard_per_s,p_passage")
+    rows = [head]
+    for i in range(n):
+        rows.append(f"{i},{int(run.tags[i])},{int(cr['n_events'][i])},"
+                    f"{cr['exposure_s'][i]:.6g},{run.removal_times[i]:.6g},"
+                    f"{cr['p_window'][i]:.6g},{cr['hazard_per_s'][i]:.6g},"
+                    f"{cr['p_passage'][i]:.6g}")
+    files.append(write_text_atomic(out / "cartridges.csv", "\n".join(rows) + "\n"))
+    files.append(_save_npz(out / "risk_arrays.npz", p_passage=cr["p_passage"],
+                           p_window=cr["p_window"], p_event=p["p_event"],
+                           **{f"map_{k}": v for k, v in rmap.items()}))
+    return files

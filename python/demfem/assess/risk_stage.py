@@ -1,0 +1,211 @@
+"""Risk: from each collision's surface stresses to a breakage probability per cartridge and
+an expected number of broken cartridges per hour.
+
+Per event k and surface s (inner, outer), Weibull weakest link on the effective area
+(:mod:`demfem.risk`, ASTM C1683):
+
+    P_k,s = 1 − exp(−(A_k,s / A_0) (σ_k,s / σ_0)^m)      (σ ≤ 0 or A = 0: P = 0)
+
+with, when slow crack growth is on (default), σ the equivalent static stress of the
+half-sine pulse of the collision's contact duration τ_k over the strength test's reference
+time t_ref, σ_eq = σ_p [(τ/t_ref) Γ((n+1)/2)/(√π Γ(n/2+1))]^{1/n}
+(:func:`demfem.risk.half_sine_equivalent_stress`, n = 25 for borosilicate). A collision breaks
+one of its two cartridges with P_k = 1 − (1 − P_k,inner)(1 − P_k,outer); both partners of a
+sphere–sphere collision take the same load and each gets its own P_k (independent glass).
+
+Over the statistics window [t_0, T] (W = T − t_0), cartridge i with events k survives with
+Π(1 − P_k): P_window,i = 1 − Π(1 − P_k) (:func:`demfem.risk.cartridge_failure_probability`).
+
+From the window to an hour of production. Cartridge i was on the table for the exposure
+e_i = min(T, t_removed,i) − t_0 of the window, so its breakage hazard rate is
+λ_i = −ln(1 − P_window,i) / e_i (1/s). A cartridge's passage over the table lasts the
+residence time, by Little's law T_res = N̄ / Q with N̄ = Σ e_i / W the mean number of cartridges
+on the table in the window and Q the throughput (cartridges/s). Then
+
+    P_passage,i = 1 − exp(−λ_i T_res),   broken per hour = Q_h × mean_i P_passage,i
+
+(:func:`demfem.risk.expected_broken_per_hour`, Q_h = cartridges per hour). For small P this is
+3600 Σ_i λ_i: the rate at which the table's population breaks, independent of Q, as long as the
+table holds the simulated population at that throughput — which is the planning assumption.
+The assumption that the simulated window is representative of the table in production (a
+steady state) is checked by :func:`steady_state`.
+
+SI units: Pa, m², s; rates per second unless named per hour.
+"""
+from __future__ import annotations
+
+import math
+from typing import Any, Optional
+
+import numpy as np
+
+from demfem.errors import check_positive, check_range
+from demfem.risk import (INNER_SURFACE, OUTER_SURFACE, SCG_BOROSILICATE, SlowCrackGrowth,
+                         SurfaceStrength, cartridge_failure_probability,
+                         expected_broken_per_hour)
+from demfem.risk.fatigue import half_sine_sn_factor
+
+__all__ = ["DEFAULT_THROUGHPUT", "event_probabilities", "surface_probability",
+           "equivalent_stress", "cartridge_risk", "steady_state", "worst_events", "risk_map"]
+
+#: Default throughput of the filling line, cartridges per hour: a planning assumption
+#: (6000/h = 100 per minute, a mid-range filling line), not a property of the table.
+DEFAULT_THROUGHPUT = 6000.0
+
+
+def surface_probability(surface: SurfaceStrength, stress: np.ndarray,
+                        area: np.ndarray) -> np.ndarray:
+    """Per-event failure probability of one surface, vectorised: the single-element case of
+    :meth:`SurfaceStrength.failure_probability` (the same formula, evaluated in log space:
+    exact down to P ~ 1e-300). ``stress`` in Pa, ``area`` in m², shape (n,)."""
+    s = np.asarray(stress, float)
+    a = np.asarray(area, float)
+    out = np.zeros(np.broadcast(s, a).shape)
+    on = (s > 0) & (a > 0)
+    log_r = (np.log(a[on] / surface.reference_area)
+             + surface.weibull_modulus * np.log(s[on] / surface.characteristic_strength))
+    out[on] = -np.expm1(-np.exp(np.minimum(log_r, 700.0)))
+    return out
+
+
+def equivalent_stress(peak: np.ndarray, duration: np.ndarray,
+                      scg: Optional[SlowCrackGrowth]) -> np.ndarray:
+    """σ_eq (Pa) of half-sine pulses of peak ``peak`` (Pa) lasting ``duration`` (s) over the
+    reference time of ``scg`` (:func:`demfem.risk.half_sine_equivalent_stress`, vectorised
+    over durations); ``scg=None``: the peak itself (no slow crack growth)."""
+    peak = np.asarray(peak, float)
+    if scg is None:
+        return np.maximum(peak, 0.0)
+    n = scg.crack_growth_exponent
+    factor = (np.asarray(duration, float) / scg.reference_time * half_sine_sn_factor(n)) ** (1 / n)
+    return np.maximum(peak, 0.0) * factor
+
+
+def event_probabilities(stress: dict[str, np.ndarray], inner: SurfaceStrength = INNER_SURFACE,
+                        outer: SurfaceStrength = OUTER_SURFACE,
+                        scg: Optional[SlowCrackGrowth] = SCG_BOROSILICATE) -> dict[str, np.ndarray]:
+    """``p_inner``, ``p_outer``, ``p_event`` and the stresses used (``sigma_eq_inner_Pa``,
+    ``sigma_eq_outer_Pa``) of each event from the stress stage's arrays ``sigma_inner_Pa``,
+    ``sigma_outer_Pa``, ``area_inner_m2``, ``area_outer_m2``, ``duration_s``."""
+    tau = stress["duration_s"]
+    s_in = equivalent_stress(stress["sigma_inner_Pa"], tau, scg)
+    s_out = equivalent_stress(stress["sigma_outer_Pa"], tau, scg)
+    p_in = surface_probability(inner, s_in, stress["area_inner_m2"])
+    p_out = surface_probability(outer, s_out, stress["area_outer_m2"])
+    p = -np.expm1(np.log1p(-p_in) + np.log1p(-p_out))
+    return {"p_inner": p_in, "p_outer": p_out, "p_event": p,
+            "sigma_eq_inner_Pa": s_in, "sigma_eq_outer_Pa": s_out}
+
+
+def cartridge_risk(events: np.ndarray, p_event: np.ndarray, n: int, removal_times: np.ndarray,
+                   window: tuple[float, float], throughput_per_hour: float) -> dict[str, Any]:
+    """Per-cartridge probabilities over the window and per passage, and the hourly rate.
+
+    Args:
+        events: the event table (:data:`demfem.assess.events.EVENT_DTYPE`).
+        p_event: (n_events,) P_k.
+        n: number of cartridges (sphere ids 0..n-1).
+        removal_times: (n,) time each left through the opening, s (NaN: stayed).
+        window: (t_0, T), s.
+        throughput_per_hour: cartridges per hour, > 0.
+
+    Returns:
+        ``p_window`` (n,), ``exposure_s`` (n,), ``hazard_per_s`` (n,), ``p_passage`` (n,),
+        ``n_events`` (n,) in the window, and the scalars ``mean_on_table``, ``residence_time_s``,
+        ``broken_per_hour``, ``broken_per_hour_small_p`` (3600 Σ λ_i), ``window_s``.
+    """
+    q = check_positive("throughput_per_hour", throughput_per_hour)
+    t0, t1 = window
+    w = t1 - t0
+    inside = (events["time"] >= t0) & (events["time"] <= t1)
+    p_in = np.asarray(p_event, float)
+    log_surv = np.zeros(n)
+    counts = np.zeros(n, np.int64)
+    neg_log = np.log1p(-np.where(inside, p_in, 0.0))
+    for col in ("i", "j"):
+        idx = np.asarray(events[col], np.int64)
+        ok = inside & (idx >= 0)
+        np.add.at(log_surv, idx[ok], neg_log[ok])
+        np.add.at(counts, idx[ok], 1)
+    # P_window,i = 1 - prod(1 - P_k) over each cartridge's own events (demfem.risk)
+    from demfem.assess.events import events_per_cartridge
+
+    lists = events_per_cartridge(events[inside], n)
+    p_win_events = p_in[inside]
+    p_window = np.array([cartridge_failure_probability(p_win_events[ix]) for ix in lists])
+    end = np.where(np.isfinite(removal_times), np.minimum(removal_times, t1), t1)
+    exposure = np.clip(end - t0, 0.0, w)
+    hazard = np.where(exposure > 0, -log_surv / np.where(exposure > 0, exposure, 1.0), 0.0)
+    mean_on = float(exposure.sum() / w) if w > 0 else 0.0
+    t_res = mean_on / (q / 3600.0)
+    p_passage = -np.expm1(-hazard * t_res)
+    present = exposure > 0
+    return {"p_window": p_window, "exposure_s": exposure, "hazard_per_s": hazard,
+            "p_passage": p_passage, "n_events": counts, "mean_on_table": mean_on,
+            "residence_time_s": t_res, "window_s": w,
+            "broken_per_hour": expected_broken_per_hour(p_passage[present], q),
+            "broken_per_hour_small_p": 3600.0 * float(hazard[present].sum())
+            if mean_on > 0 else 0.0}
+
+
+def steady_state(events: np.ndarray, p_event: np.ndarray,
+                 window: tuple[float, float]) -> dict[str, Any]:
+    """How steady the window is: events and hazard (Σ −ln(1 − P_k), both partners) per second
+    in its first and second half, their ratio, and the Poisson z = (n_2 − n_1)/√(n_1 + n_2)
+    of the event counts (|z| < 2: no drift detectable at the 95 % level)."""
+    t0, t1 = window
+    mid = 0.5 * (t0 + t1)
+    half = 0.5 * (t1 - t0)
+    t = events["time"]
+    h = -np.log1p(-np.asarray(p_event, float)) * np.where(events["j"] >= 0, 2.0, 1.0)
+    a = (t >= t0) & (t < mid)
+    b = (t >= mid) & (t <= t1)
+    n1, n2 = int(a.sum()), int(b.sum())
+    z = (n2 - n1) / math.sqrt(n1 + n2) if n1 + n2 > 0 else 0.0
+    h1, h2 = float(h[a].sum()), float(h[b].sum())
+    return {"window_s": [t0, t1], "events_first_half": n1, "events_second_half": n2,
+            "rate_first_half_per_s": n1 / half if half > 0 else math.nan,
+            "rate_second_half_per_s": n2 / half if half > 0 else math.nan,
+            "rate_ratio": n2 / n1 if n1 > 0 else math.nan, "poisson_z": z,
+            "steady": bool(abs(z) < 2.0),
+            "hazard_first_half": h1, "hazard_second_half": h2,
+            "hazard_ratio": h2 / h1 if h1 > 0 else math.nan}
+
+
+def worst_events(events: np.ndarray, p: dict[str, np.ndarray], stress: dict[str, np.ndarray],
+                 window: tuple[float, float], count: int = 10) -> list[dict[str, Any]]:
+    """The ``count`` events of the window with the largest P_k, as rows (SI units in keys)."""
+    from demfem.assess.impact import PARTNERS
+
+    inside = np.flatnonzero((events["time"] >= window[0]) & (events["time"] <= window[1]))
+    order = inside[np.argsort(-p["p_event"][inside], kind="stable")][:count]
+    rows = []
+    for k in order:
+        e = events[k]
+        rows.append({"event": int(k), "i": int(e["i"]), "j": int(e["j"]),
+                     "partner": PARTNERS[int(e["partner"])], "time_s": float(e["time"]),
+                     "x_m": float(e["x"]), "y_m": float(e["y"]),
+                     "normal_speed_m_per_s": float(e["normal_speed"]),
+                     "force_N": float(stress["force_N"][k]),
+                     "sigma_inner_Pa": float(stress["sigma_inner_Pa"][k]),
+                     "sigma_outer_Pa": float(stress["sigma_outer_Pa"][k]),
+                     "p_inner": float(p["p_inner"][k]), "p_outer": float(p["p_outer"][k]),
+                     "p_event": float(p["p_event"][k])})
+    return rows
+
+
+def risk_map(events: np.ndarray, p_event: np.ndarray, window: tuple[float, float],
+             extent: tuple[float, float, float, float], bins: int = 24) -> dict[str, Any]:
+    """2-D histogram over the table (x, y of the contact point) of the hazard the window's
+    events put on the cartridges (Σ −ln(1 − P_k), both partners), and of the event count.
+    ``extent`` = (x_min, x_max, y_min, y_max), m."""
+    x0, x1, y0, y1 = (float(v) for v in extent)
+    check_range("extent x_max", x1, x0, math.inf)
+    check_range("extent y_max", y1, y0, math.inf)
+    sel = (events["time"] >= window[0]) & (events["time"] <= window[1])
+    h = -np.log1p(-np.asarray(p_event, float)) * np.where(events["j"] >= 0, 2.0, 1.0)
+    edges = (np.linspace(x0, x1, bins + 1), np.linspace(y0, y1, bins + 1))
+    hz, ex, ey = np.histogram2d(events["x"][sel], events["y"][sel], bins=edges,
+                                weights=h[sel])
+    cnt, _, _ = np.histogram2d(events["x"][sel], events["y"][sel], bins=edges)
+    return {"hazard": hz, "count": cnt, "x_edges": ex, "y_edges": ey}

@@ -1,0 +1,278 @@
+"""`demfem assess`: from every collision of a DEM run of the table to a breakage probability
+per cartridge, in six resumable stages (:data:`demfem.assess.stages.STAGES`):
+
+1. **calibration** — the cartridge's equivalent body, its Hertz–Reissner law and the stress
+   model in use (``calibration.json``);
+2. **dem** — the table run (:func:`demfem.studies.table_run.run_table`, ``table_run.npz``;
+   checkpoints into ``table.ck`` and resumes mid-run);
+3. **events** — impact events above the minimum speed (``events.npz``);
+4. **stress** — force, duration, σ1 and stressed area per event (``stress.npz``);
+5. **risk** — P per event, per cartridge and per hour, steady state, worst events, risk map
+   (``risk.json``, ``events.csv``, ``cartridges.csv``, ``risk_arrays.npz``);
+6. **report** — ``report.html`` and the figures.
+
+SI units throughout: m, s, kg, N, Pa.
+"""
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+from pathlib import Path
+from typing import Any, Callable, Optional
+
+import numpy as np
+
+from demfem.assess.events import DEFAULT_MIN_SPEED
+from demfem.assess.risk_stage import DEFAULT_THROUGHPUT
+from demfem.assess.stages import STAGES, StageBook
+from demfem.assess.stress_model import StressModel
+from demfem.errors import InvalidParameterError, check_positive, check_range
+
+__all__ = ["assess", "OUTPUT_FILES", "QUICK_DURATION", "DEFAULT_DURATION"]
+
+#: Default and --quick simulated time of the table, s.
+DEFAULT_DURATION = 1.0
+QUICK_DURATION = 0.1
+
+#: Files the job writes (removed by a fresh start), besides the DEM checkpoint.
+OUTPUT_FILES = ("calibration.json", "table_run.npz", "events.npz", "stress.npz", "risk.json",
+                "events.csv", "cartridges.csv", "risk_arrays.npz", "report.html")
+
+
+def _save_npz(path: Path, **arrays: np.ndarray) -> Path:
+    from demfem.io.atomic import atomic_path
+
+    with atomic_path(path, suffix=".npz") as tmp:
+        with open(tmp, "wb") as fh:
+            np.savez(fh, **arrays)
+    return path
+
+
+def _load_npz(path: Path) -> dict[str, np.ndarray]:
+    with np.load(path, allow_pickle=False) as data:
+        return {k: data[k] for k in data.files}
+
+
+def _flatten(d: dict[str, Any], prefix: str = "") -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for k, v in d.items():
+        if isinstance(v, dict):
+            out.update(_flatten(v, f"{prefix}{k}."))
+        else:
+            out[f"{prefix}{k}"] = v
+    return out
+
+
+def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
+           duration: Optional[float] = None, quick: bool = False,
+           throughput: float = DEFAULT_THROUGHPUT, fresh: bool = False,
+           sample_interval: Optional[float] = None, min_speed: float = DEFAULT_MIN_SPEED,
+           discard_before: Optional[float] = None, stress_model: Optional[StressModel] = None,
+           stress_young_modulus: Optional[float] = None, slow_crack_growth: bool = True,
+           threads: int = 1, checkpoint_every: float = 15.0,
+           log: Callable[[str], None] = print, progress: bool = False,
+           stop_after: Optional[str] = None) -> dict[str, Any]:
+    """Run (or resume) the assessment; returns the risk document (``risk.json``'s content).
+
+    Args:
+        scene: the table: None (built-in default), an AccumulationTable or a TOML file.
+        out: output folder.
+        duration: simulated time of the table, s (default 1.0; ``quick``: 0.1).
+        quick: a smoke run (0.1 s simulated).
+        throughput: cartridges per hour through the table, > 0 (a planning assumption).
+        fresh: replace an assessment with other settings in ``out`` instead of refusing it.
+        sample_interval: time between recorded samples, s (default 0.02; quick 0.01).
+        min_speed: minimum normal impact speed of an event, m/s (≥ 0).
+        discard_before: start of the statistics window, s (default: half the run).
+        stress_model: the :class:`StressModel` (default: the shipped one).
+        stress_young_modulus: Young's modulus at which the collision forces are evaluated, Pa
+            (default: the scene's, i.e. the DEM's).
+        slow_crack_growth: use the half-sine equivalent stress over the contact duration.
+        threads: DEM threads (results are the same on any number).
+        checkpoint_every: wall time between DEM checkpoints, s.
+        log: where progress lines go.
+        progress: a progress bar on standard error for the DEM stage.
+        stop_after: stop after this stage (one of STAGES): a later call resumes from there.
+    """
+    from demfem.pipeline import load_scene
+    from demfem.risk import INNER_SURFACE, OUTER_SURFACE, SCG_BOROSILICATE
+    from demfem.studies.table_run import check_run_arguments
+
+    # every argument checked before any work
+    if duration is None:
+        duration = QUICK_DURATION if quick else DEFAULT_DURATION
+    if sample_interval is None:
+        sample_interval = min(0.01 if quick else 0.02, float(duration)) if isinstance(
+            duration, (int, float)) and math.isfinite(duration) and duration > 0 else 0.02
+    check_run_arguments(duration, sample_interval, threads)
+    duration = float(duration)
+    q = check_positive("throughput", throughput)
+    v_min = check_range("min_speed", min_speed, 0.0, math.inf, lo_open=False)
+    t0 = 0.5 * duration if discard_before is None else check_range(
+        "discard_before", discard_before, 0.0, duration, lo_open=False)
+    check_positive("checkpoint_every", checkpoint_every)
+    if stop_after is not None and stop_after not in STAGES:
+        raise InvalidParameterError(f"invalid stop_after = {stop_after!r}: must be one of "
+                                    f"{STAGES}")
+    table = load_scene(scene)
+    model = stress_model if stress_model is not None else StressModel.default()
+    if not isinstance(model, StressModel):
+        raise InvalidParameterError(f"invalid stress_model = {model!r}: must be a StressModel")
+    e_stress = float(table.young_modulus) if stress_young_modulus is None else check_positive(
+        "stress_young_modulus", stress_young_modulus)
+    scg = SCG_BOROSILICATE if slow_crack_growth else None
+    settings = {"scene": dataclasses.asdict(table), "duration_s": duration,
+                "sample_interval_s": float(sample_interval), "min_speed_m_per_s": v_min,
+                "statistics_from_s": t0, "throughput_per_hour": q,
+                "stress_young_modulus_Pa": e_stress, "stress_model": model.to_dict(),
+                "slow_crack_growth": dataclasses.asdict(scg) if scg else None,
+                "inner_surface": dataclasses.asdict(INNER_SURFACE),
+                "outer_surface": dataclasses.asdict(OUTER_SURFACE),
+                "dem_model": "hertz_reissner_mindlin"}
+    out = Path(out)
+    from demfem.studies.table_run import remove_checkpoint
+
+    if fresh:
+        remove_checkpoint(out / "table.ck")
+    book = StageBook(out, settings, fresh, OUTPUT_FILES)
+    from demfem.assess.figures import FIGURES as figures_names
+
+    n_st = len(STAGES)
+
+    def header(k: int, text: str, done: bool) -> None:
+        log(f"== {k}/{n_st} {STAGES[k - 1]}: {text}" + (" (done before: reused) ==" if done
+                                                          else " =="))
+
+    # 1. calibration
+    from demfem.assess.impact import ImpactLaw, cartridge_body
+
+    done = book.is_done("calibration")
+    header(1, "equivalent body, contact law and stress model", done)
+    cal_path = out / "calibration.json"
+    if not done:
+        from demfem.io.strict_json import write_json_atomic
+
+        body = cartridge_body(e_stress, table.poisson_ratio)
+        law = ImpactLaw(body, body)
+        speeds = [0.005, 0.01, 0.02, 0.05, 0.1, 0.2]
+        cal = {"young_modulus_Pa": e_stress, "poisson_ratio": body.nu,
+               "mass_kg": body.mass, "hertz_radius_m": body.radius,
+               "shell_thickness_m": body.shell_thickness, "shell_radius_m": body.shell_radius,
+               "reissner_stiffness_N_per_m": body.k_reissner,
+               "law": "hertz_reissner (eq. 12 of the paper)",
+               "speeds_m_per_s": speeds, "force_N": law.force(np.array(speeds)),
+               "duration_s": law.duration(np.array(speeds)),
+               "sigma_inner_Pa": model.sigma_inner(law.force(np.array(speeds))),
+               "stress_model": model.to_dict()}
+        write_json_atomic(cal_path, cal)
+        book.complete("calibration", [cal_path])
+    cal = json.loads(cal_path.read_text(encoding="utf-8"))
+    log("  v_n [m/s]: " + " ".join(f"{v:g}" for v in cal["speeds_m_per_s"]))
+    log("  F [N]:     " + " ".join(f"{f:.3g}" for f in cal["force_N"]))
+    log(f"  stress model: sigma1 = {model.beta_inner:.3g} F/t^2 (inner), "
+        f"{model.beta_outer:.3g} F/t^2 (outer), t = {model.thickness:g} m")
+    if stop_after == "calibration":
+        return {"stopped_after": "calibration"}
+
+    # 2. DEM
+    from demfem.studies.table_run import TableRun, run_table
+
+    run_path = out / "table_run.npz"
+    done = book.is_done("dem")
+    header(2, f"the table, {table.n_spheres} spheres, E = {table.young_modulus:.3g} Pa, "
+              f"{duration:g} s", done)
+    if not done:
+        from demfem.progress import ProgressBar
+
+        bar = ProgressBar(duration, label="table") if progress else None
+        try:
+            run = run_table(table, duration, sample_interval, threads=threads,
+                            progress=bar, checkpoint=out / "table.ck",
+                            checkpoint_every=checkpoint_every, fresh=fresh)
+        finally:
+            if bar is not None:
+                bar.close()
+        run.save(run_path)
+        book.complete("dem", [run_path])
+    else:
+        run = TableRun.load(run_path)
+    log(f"  {run.info['steps']} steps of {run.info['dt']:.3g} s, "
+        f"{len(run.onsets)} contact onsets, wall {run.info['wall_time_s']:.1f} s")
+    if stop_after == "dem":
+        return {"stopped_after": "dem"}
+
+    # 3. events
+    from demfem.assess.events import EVENT_DTYPE, impact_events
+
+    ev_path = out / "events.npz"
+    done = book.is_done("events")
+    header(3, f"impact events (normal speed >= {v_min:g} m/s)", done)
+    if not done:
+        events, ev_summary = impact_events(run, v_min)
+        _save_npz(ev_path, events=events, summary=np.array(json.dumps(ev_summary)))
+        book.complete("events", [ev_path])
+    data = _load_npz(ev_path)
+    events = data["events"].astype(EVENT_DTYPE)
+    ev_summary = json.loads(str(data["summary"]))
+    log(f"  {ev_summary['n_events']} events of {ev_summary['n_onsets']} onsets "
+        f"({ev_summary['n_dropped']} below {v_min:g} m/s dropped)")
+    if stop_after == "events":
+        return {"stopped_after": "events"}
+
+    # 4. stress
+    from demfem.assess.stress_stage import collision_stresses
+
+    st_path = out / "stress.npz"
+    done = book.is_done("stress")
+    header(4, "force, duration, sigma1 and stressed area per event", done)
+    if not done:
+        stress = collision_stresses(events["normal_speed"], events["partner"], model,
+                                    e_stress, table.poisson_ratio)
+        _save_npz(st_path, **stress)
+        book.complete("stress", [st_path])
+    stress = _load_npz(st_path)
+    if len(events):
+        log(f"  peak force up to {stress['force_N'].max():.3g} N, inner sigma1 up to "
+            f"{stress['sigma_inner_Pa'].max() / 1e6:.3g} MPa")
+    if stop_after == "stress":
+        return {"stopped_after": "stress"}
+
+    # 5. risk
+    from demfem.assess.risk_product import risk_document
+
+    done = book.is_done("risk")
+    header(5, "Weibull probabilities per event, cartridge and hour", done)
+    if not done:
+        files = risk_document(out, run, table, events, ev_summary, stress, model, scg,
+                              (t0, duration), q, settings, e_stress)
+        book.complete("risk", files)
+    risk = json.loads((out / "risk.json").read_text(encoding="utf-8"))
+    s = risk["summary"]
+    log(f"  P per passage: mean {s['p_passage_mean']:.3g}, max {s['p_passage_max']:.3g}; "
+        f"expected broken per hour at {q:g}/h: {s['broken_per_hour']:.3g}")
+    if stop_after == "risk":
+        return risk
+
+    # 6. report
+    from demfem.assess.figures import make_figures
+    from demfem.assess.report import render_report
+    from demfem.io.atomic import write_text_atomic
+
+    done = book.is_done("report")
+    header(6, "report.html", done)
+    if not done:
+        arrays = _load_npz(out / "risk_arrays.npz")
+        figs = make_figures(out, {
+            "map": {k: arrays[f"map_{k}"] for k in ("hazard", "count", "x_edges", "y_edges")},
+            "onset_speeds": run.onsets["normal_speed"], "events": events,
+            "window": (t0, duration), "min_speed": v_min, "stress": stress, "model": model,
+            "p_passage": arrays["p_passage"], "steady": risk["steady_state"],
+            "duration": duration})
+        html_path = write_text_atomic(out / "report.html",
+                                      render_report(risk, figs, figures_names))
+        book.complete("report", [html_path, *(out / n for n in figs)])
+    log(f"  written to {out}: report.html, risk.json, events.csv, cartridges.csv, "
+        + ", ".join(figures_names))
+    return risk
+

@@ -1,0 +1,60 @@
+"""The stress stage: each impact event → peak contact force, contact radius and duration
+(calibrated Hertz–Reissner law, :mod:`demfem.assess.impact`) → peak σ1 and effective area on
+the inner and on the outer surface (:class:`demfem.assess.StressModel`).
+
+The collision's inputs are its normal relative speed at onset (m/s), its partner type
+(sphere: another cartridge's equivalent body; wall: a flat immovable half-space of the wall's
+glass) and the Young's modulus E (Pa) at which the forces are evaluated. The tangential speed
+is not used: the stress model is that of a radial load (the paper's FEM shows tangential
+forces of ≈ 1/6 of the normal ones, Fig. 11).
+
+SI units: m/s, N, m, s, Pa, m².
+"""
+from __future__ import annotations
+
+from typing import Optional
+
+import numpy as np
+
+from demfem.assess.impact import ImpactLaw, cartridge_body, flat_partner
+from demfem.assess.stress_model import StressModel
+from demfem.errors import check_positive
+
+__all__ = ["collision_stresses", "STRESS_FIELDS"]
+
+#: Arrays of the stress stage, one value per event (units in the names).
+STRESS_FIELDS = ("force_N", "contact_radius_m", "duration_s", "sigma_inner_Pa",
+                 "sigma_outer_Pa", "area_inner_m2", "area_outer_m2")
+
+
+def collision_stresses(normal_speed: np.ndarray, partner: np.ndarray, model: StressModel,
+                       young_modulus: float, poisson_ratio: Optional[float] = None,
+                       wall_modulus: Optional[float] = None) -> dict[str, np.ndarray]:
+    """Loads and stresses of collisions at normal speeds ``normal_speed`` (m/s, > 0) with
+    partner codes ``partner`` (0 sphere, 1 wall), for glass of ``young_modulus`` (Pa) and
+    ``poisson_ratio`` (default: the cartridge glass's), walls of ``wall_modulus`` (Pa,
+    default: the same glass). Returns the :data:`STRESS_FIELDS` arrays."""
+    v = np.asarray(normal_speed, float)
+    code = np.asarray(partner, np.int64)
+    E = check_positive("young_modulus", young_modulus)
+    body = cartridge_body(E, poisson_ratio)
+    laws = {0: ImpactLaw(body, body),
+            1: ImpactLaw(body, flat_partner(E if wall_modulus is None else
+                                            check_positive("wall_modulus", wall_modulus),
+                                            body.nu))}
+    out = {k: np.zeros(v.shape) for k in STRESS_FIELDS}
+    for c, law in laws.items():
+        sel = code == c
+        if not np.any(sel):
+            continue
+        f = law.force(v[sel])
+        a = law.contact_radius(f)
+        out["force_N"][sel] = f
+        out["contact_radius_m"][sel] = a
+        out["duration_s"][sel] = law.duration(v[sel])
+        out["sigma_inner_Pa"][sel] = model.sigma_inner(f)
+        out["sigma_outer_Pa"][sel] = model.sigma_outer(f)
+        a_in, a_out = model.stressed_areas(a)
+        out["area_inner_m2"][sel] = a_in
+        out["area_outer_m2"][sel] = a_out
+    return out
