@@ -186,6 +186,19 @@ def _cmd_equivalence(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_assess(args: argparse.Namespace) -> int:
+    from demfem.assess import assess
+
+    result = assess(args.scene, out=args.out, duration=args.duration, quick=args.quick,
+                    throughput=args.throughput, fresh=args.fresh, threads=args.threads,
+                    progress=True, log=lambda line: print(line, flush=True))
+    s = result["summary"]
+    print(f"P per passage: mean {s['p_passage_mean']:.3g}, max {s['p_passage_max']:.3g}; "
+          f"expected broken per hour: {s['broken_per_hour']:.3g} (report: {args.out}/"
+          "report.html)")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``demfem`` command."""
     p = _Parser(prog="demfem", description="DEM-FEM breakage of glass cartridges on a "
@@ -253,6 +266,23 @@ def build_parser() -> argparse.ArgumentParser:
                    help="simulated time, s (2.0)")
     e.add_argument("--out", default="demfem_out/equivalence", help="output directory")
     e.set_defaults(func=_cmd_equivalence)
+    a = sub.add_parser("assess", help="breakage risk: calibration, DEM, collision events, "
+                       "stress model, Weibull risk per cartridge and per hour, HTML report")
+    a.add_argument("scene", nargs="?", default=None, metavar="SCENE.toml",
+                   help="table scene file (default: the built-in default table)")
+    a.add_argument("--duration", type=float, default=None,
+                   help="simulated time of the table, s (1.0; --quick: 0.1)")
+    a.add_argument("--out", default="demfem_out/assess", help="output directory "
+                   "(demfem_out/assess); the same settings there resume from the last "
+                   "completed stage, other settings are refused")
+    a.add_argument("--quick", action="store_true", help="a smoke run (0.1 s simulated)")
+    a.add_argument("--throughput", type=float, default=6000.0, metavar="PER_HOUR",
+                   help="cartridges per hour through the table (6000, a planning assumption)")
+    a.add_argument("--threads", type=int, default=min(2, os.cpu_count() or 1),
+                   help="DEM engine threads (results are the same on any number)")
+    a.add_argument("--fresh", "--overwrite", dest="fresh", action="store_true",
+                   help="replace the assessment in --out (its outputs are removed)")
+    a.set_defaults(func=_cmd_assess)
     return p
 
 
@@ -265,7 +295,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         args = build_parser().parse_args(argv)
     except SystemExit as exc:  # --help, --version, or a bad argument (already reported)
         return int(exc.code or 0) if not isinstance(exc.code, str) else 2
-    fresh_hint = " (to start afresh: demfem run ... --fresh)" if args.command == "run" else ""
+    fresh_hint = (f" (to start afresh: demfem {args.command} ... --fresh)"
+                  if args.command in ("run", "assess") else "")
     try:
         return int(args.func(args))
     except SimulationInterrupted as exc:

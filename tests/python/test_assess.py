@@ -1,0 +1,249 @@
+"""`demfem assess`: stress model, impact law, risk, resumable stages, report and CLI.
+
+Closed forms checked: the Hertz–Reissner duration reduces to the Hertz duration without a
+shell; the shell's membrane force under a point load tends to −P R/(16 ℓ²); the per-event
+Weibull and slow-crack-growth formulas equal demfem.risk's functions.
+"""
+import csv
+import json
+import math
+import re
+
+import numpy as np
+import pytest
+
+from demfem.assess import STAGES, StressModel, assess, closed_form_model
+from demfem.assess.closed_form import (closed_form_coefficients, patch_centre_coefficients,
+                                       point_load_surface_stresses)
+from demfem.assess.events import EVENT_DTYPE
+from demfem.assess.figures import FIGURES
+from demfem.assess.impact import ImpactLaw, cartridge_body, flat_partner, impact_duration
+from demfem.assess.risk_stage import (cartridge_risk, equivalent_stress, event_probabilities,
+                                      surface_probability)
+from demfem.assess.stress_stage import collision_stresses
+from demfem.cli import main
+from demfem.contact import ContactBody, hertz_contact_duration, max_contact_force
+from demfem.errors import InvalidParameterError, SettingsMismatchError
+from demfem.risk import INNER_SURFACE, OUTER_SURFACE, SCG_BOROSILICATE
+from demfem.scenes.table import AccumulationTable
+
+SMALL = AccumulationTable(width=0.1, length=0.1, tilted_wall_length=0.05, n_spheres=30)
+
+
+# ---- stress model ----------------------------------------------------------------------------
+
+def test_sigma_scales_linearly_with_force():
+    m = StressModel.default()
+    f = np.array([0.5, 1.0, 2.0, 40.0])
+    assert np.allclose(m.sigma_inner(2 * f), 2 * m.sigma_inner(f), rtol=1e-14)
+    assert np.allclose(m.sigma_inner(f), m.beta_inner * f / m.thickness**2, rtol=1e-14)
+    assert np.allclose(m.sigma_outer(f), m.beta_outer * f / m.thickness**2, rtol=1e-14)
+    # inner in tension, outer nearly unloaded: the paper's Fig. 13 sign pattern
+    assert m.beta_inner > 1.0 and abs(m.beta_outer) < 0.1 * m.beta_inner
+
+
+def test_fit_recovers_the_coefficients():
+    rng = np.random.default_rng(3)
+    t = 1.1e-3
+    f = rng.uniform(1.0, 80.0, 40)
+    exact = StressModel.fit(f, 1.37 * f / t**2, -0.21 * f / t**2, thickness=t)
+    assert exact.beta_inner == pytest.approx(1.37, rel=1e-12)
+    assert exact.beta_outer == pytest.approx(-0.21, rel=1e-12)
+    noisy = StressModel.fit(f, 1.37 * f / t**2 * (1 + 0.02 * rng.standard_normal(40)),
+                            0.3 * f / t**2 * (1 + 0.02 * rng.standard_normal(40)))
+    assert noisy.beta_inner == pytest.approx(1.37, rel=0.02)
+    assert noisy.beta_outer == pytest.approx(0.3, rel=0.02)
+    assert noisy.residuals(f, 1.37 * f / t**2, 0.3 * f / t**2)["rms_inner_relative"] < 0.02
+    with pytest.raises(InvalidParameterError, match="forces"):
+        StressModel.fit([], [], [])
+
+
+def test_save_load_round_trip_and_the_shipped_default(tmp_path):
+    m = StressModel.fit([1.0, 2.0], [1e6, 2e6], [0.0, 0.0], source="synthetic")
+    p = m.save(tmp_path / "model.json")
+    back = StressModel.load(p)
+    assert back == m
+    json.loads(p.read_text())  # strict JSON
+    default = StressModel.default()
+    assert "Reissner" in default.source
+    # the shipped file is what closed_form_model computes
+    again = closed_form_model()
+    for name in ("beta_inner", "beta_outer", "area_factor_inner", "area_factor_outer"):
+        assert getattr(default, name) == pytest.approx(getattr(again, name), rel=1e-9)
+    (tmp_path / "bad.json").write_text('{"beta_inner": 1}')
+    with pytest.raises(InvalidParameterError, match="missing keys"):
+        StressModel.load(tmp_path / "bad.json")
+
+
+def test_closed_form_shell_solution():
+    nu = 0.22
+    field = point_load_surface_stresses(np.array([1e-3]), nu)
+    # membrane part at the load: N = -P R/(16 l^2) -> sigma t^2/P = -sqrt(12(1-nu^2))/16
+    membrane = 0.5 * (field["inner_r"] + field["outer_r"])
+    assert membrane[0] == pytest.approx(-math.sqrt(12 * (1 - nu**2)) / 16, rel=1e-3)
+    inner, outer = patch_centre_coefficients(10.0, nu)
+    assert inner > 0 > outer  # inner tension, outer compression under the load
+    # the beta grows as the contact patch shrinks (log singularity of the point load)
+    small = closed_form_coefficients(1.1e-3, 5.25e-3, nu, 3e-5)
+    large = closed_form_coefficients(1.1e-3, 5.25e-3, nu, 1.5e-4)
+    assert small.beta_inner > large.beta_inner
+    assert small.beta_inner - large.beta_inner == pytest.approx(
+        3 * (1 + nu) / (2 * math.pi) * math.log(5.0), rel=1e-9)
+
+
+# ---- impact law and stresses -----------------------------------------------------------------
+
+def test_impact_duration_reduces_to_hertz_and_table_interpolates():
+    body = cartridge_body(45e9)
+    solid = ContactBody(body.mass, body.radius, body.E, body.nu)
+    assert impact_duration(solid, solid, 0.05) == pytest.approx(
+        hertz_contact_duration(solid, solid, 0.05), rel=1e-8)
+    law = ImpactLaw(body, body)
+    v = np.array([3e-3, 0.0123, 0.071, 0.4])
+    direct = [max_contact_force(body, body, x, "hertz_reissner") for x in v]
+    assert np.allclose(law.force(v), direct, rtol=1e-5)
+    assert np.allclose(law.duration(v), [impact_duration(body, body, x) for x in v], rtol=1e-5)
+    wall = ImpactLaw(body, flat_partner(45e9, body.nu))
+    assert wall.force(np.array([0.05]))[0] > law.force(np.array([0.05]))[0]  # m* doubles
+
+
+def test_collision_stresses_use_the_calibrated_law():
+    m = StressModel.default()
+    s = collision_stresses(np.array([0.01, 0.05]), np.array([0, 1]), m, 45e9)
+    body = cartridge_body(45e9)
+    assert s["force_N"][0] == pytest.approx(max_contact_force(body, body, 0.01), rel=1e-5)
+    assert s["force_N"][1] == pytest.approx(
+        max_contact_force(body, flat_partner(45e9, body.nu), 0.05), rel=1e-5)
+    assert np.allclose(s["sigma_inner_Pa"], m.sigma_inner(s["force_N"]))
+    assert np.all(s["area_inner_m2"] > 0) and np.all(s["duration_s"] > 0)
+
+
+# ---- risk ------------------------------------------------------------------------------------
+
+def _synthetic_events(speeds, times=None):
+    ev = np.zeros(len(speeds), EVENT_DTYPE)
+    ev["i"] = np.arange(len(speeds)) % 4
+    ev["j"] = (np.arange(len(speeds)) + 1) % 4
+    ev["normal_speed"] = speeds
+    ev["time"] = np.linspace(0.5, 1.0, len(speeds)) if times is None else times
+    return ev
+
+
+def _risk(speeds):
+    ev = _synthetic_events(speeds)
+    st = collision_stresses(ev["normal_speed"], ev["partner"], StressModel.default(), 45e9)
+    p = event_probabilities(st)
+    return ev, st, p, cartridge_risk(ev, p["p_event"], 4, np.full(4, np.nan), (0.5, 1.0), 6000)
+
+
+def test_risk_rises_with_impact_speed():
+    v = np.array([0.01, 0.02, 0.05, 0.1, 0.3])
+    _, _, p1, c1 = _risk(v)
+    _, _, p2, c2 = _risk(2 * v)
+    assert np.all(np.diff(p1["p_event"]) > 0)
+    assert np.all(p2["p_event"] > p1["p_event"])
+    assert c2["broken_per_hour"] > c1["broken_per_hour"] > 0
+    # small P: the hourly number is 3600 x the summed hazard rate of the population
+    assert c1["broken_per_hour"] == pytest.approx(c1["broken_per_hour_small_p"], rel=1e-6)
+    assert c1["residence_time_s"] == pytest.approx(4 / (6000 / 3600))
+
+
+def test_per_event_probabilities_match_demfem_risk():
+    ev, st, p, _ = _risk(np.array([0.02, 0.2, 0.5]))
+    for k in range(3):
+        s_in = SCG_BOROSILICATE.half_sine(st["sigma_inner_Pa"][k], st["duration_s"][k])
+        assert p["sigma_eq_inner_Pa"][k] == pytest.approx(s_in, rel=1e-12)
+        assert p["p_inner"][k] == pytest.approx(INNER_SURFACE.failure_probability(
+            [s_in], [st["area_inner_m2"][k]]), rel=1e-9)
+        s_out = SCG_BOROSILICATE.half_sine(st["sigma_outer_Pa"][k], st["duration_s"][k])
+        assert p["p_outer"][k] == pytest.approx(OUTER_SURFACE.failure_probability(
+            [s_out], [st["area_outer_m2"][k]]), rel=1e-9)
+    assert np.all(equivalent_stress(np.array([1e6]), np.array([1e-4]), None) == 1e6)
+    assert surface_probability(INNER_SURFACE, np.array([-1e6, 0.0]), np.array([1e-6, 1e-6])
+                               ).tolist() == [0.0, 0.0]
+
+
+# ---- the job ---------------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def small_job(tmp_path_factory):
+    out = tmp_path_factory.mktemp("assess_full")
+    lines = []
+    risk = assess(SMALL, out=out, duration=0.12, sample_interval=0.01, log=lines.append)
+    return out, risk, lines
+
+
+def test_interrupted_assess_resumes_to_the_same_numbers(small_job, tmp_path):
+    full_out, full, _ = small_job
+    lines = []
+    stopped = assess(SMALL, out=tmp_path, duration=0.12, sample_interval=0.01,
+                     log=lines.append, stop_after="dem")
+    assert stopped == {"stopped_after": "dem"}
+    book = json.loads((tmp_path / "stages.json").read_text())
+    assert set(book["completed"]) == {"calibration", "dem"}
+    lines = []
+    resumed = assess(SMALL, out=tmp_path, duration=0.12, sample_interval=0.01,
+                     log=lines.append)
+    text = "\n".join(lines)
+    assert "1/6 calibration" in text and text.count("(done before: reused)") == 2
+    assert json.loads((tmp_path / "risk.json").read_text())["summary"] == \
+        json.loads((full_out / "risk.json").read_text())["summary"]
+    assert resumed["summary"] == full["summary"]
+    assert (tmp_path / "events.csv").read_text() == (full_out / "events.csv").read_text()
+    # a rerun skips every stage
+    lines = []
+    assess(SMALL, out=tmp_path, duration=0.12, sample_interval=0.01, log=lines.append)
+    assert "\n".join(lines).count("(done before: reused)") == len(STAGES)
+    # other settings: refused, naming the difference; --fresh replaces
+    with pytest.raises(SettingsMismatchError, match="throughput_per_hour"):
+        assess(SMALL, out=tmp_path, duration=0.12, sample_interval=0.01, throughput=100.0,
+               log=lines.append)
+    other = assess(SMALL, out=tmp_path, duration=0.12, sample_interval=0.01, throughput=100.0,
+                   fresh=True, log=lambda _: None)
+    assert other["summary"]["throughput_per_hour"] == 100.0
+
+
+def test_outputs_and_report(small_job):
+    out, risk, _ = small_job
+    doc = json.loads((out / "risk.json").read_text())  # strict JSON: parses
+    assert doc["summary"]["n_events_window"] == risk["summary"]["n_events_window"]
+    rows = list(csv.DictReader(open(out / "events.csv")))
+    assert len(rows) == doc["events"]["n_events"]
+    assert all(float(r["normal_speed_m_per_s"]) >= 5e-3 for r in rows)
+    cart = list(csv.DictReader(open(out / "cartridges.csv")))
+    assert len(cart) == SMALL.n_spheres
+    p = np.array([float(r["p_passage"]) for r in cart])
+    assert np.mean(p) == pytest.approx(doc["summary"]["p_passage_mean"], rel=1e-5)
+    html_text = (out / "report.html").read_text()
+    imgs = re.findall(r'<img src="data:image/png;base64,([A-Za-z0-9+/=]+)"', html_text)
+    assert len(imgs) == len(FIGURES)
+    assert all(len(b) > 1000 for b in imgs)
+    assert "<table class='summary'>" in html_text and "expected broken per hour" in html_text
+    assert "planning assumption" in html_text.lower()
+    assert not re.search(r'(src|href)="(http|//)', html_text) and "<script" not in html_text
+    st = doc["steady_state"]
+    assert st["window_s"] == [0.06, 0.12]
+    assert st["events_first_half"] + st["events_second_half"] == doc["summary"][
+        "n_events_window"]
+
+
+@pytest.mark.parametrize("kwargs, field", [
+    (dict(throughput=-1.0), "throughput"), (dict(duration=float("nan")), "duration"),
+    (dict(min_speed=-1e-3), "min_speed"), (dict(discard_before=5.0), "discard_before"),
+    (dict(stop_after="nope"), "stop_after")])
+def test_bad_parameters_name_the_field(tmp_path, kwargs, field):
+    with pytest.raises(InvalidParameterError, match=field):
+        assess(SMALL, out=tmp_path, **{"duration": 0.1, **kwargs})
+    assert not (tmp_path / "stages.json").exists()
+
+
+def test_cli_assess_quick(tmp_path, capsys):
+    out = tmp_path / "q"
+    assert main(["assess", "--quick", "--out", str(out)]) == 0
+    assert (out / "report.html").exists() and (out / "risk.json").exists()
+    assert "expected broken per hour" in capsys.readouterr().out
+    assert main(["assess", "--quick", "--out", str(out), "--throughput", "10"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("demfem: error:") and "throughput_per_hour" in err
+    assert main(["assess", "--throughput", "-3", "--out", str(tmp_path / "x")]) == 2
+    assert "throughput" in capsys.readouterr().err
