@@ -53,6 +53,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.integrate import trapezoid
 from scipy.special import kei, keip, ker, kerp
 
 from demfem.errors import InvalidParameterError, check_positive, check_range
@@ -143,7 +144,7 @@ def _effective_area(r: np.ndarray, s: np.ndarray, m: float) -> float:
     if smax <= 0:
         return 0.0
     f = np.maximum(s / smax, 0.0) ** m * 2.0 * math.pi * r
-    return float(np.trapezoid(f, r)) if hasattr(np, "trapezoid") else float(np.trapz(f, r))
+    return float(trapezoid(f, r))
 
 
 def closed_form_coefficients(thickness: float, shell_radius: float, nu: float,
