@@ -73,7 +73,7 @@ def make_figures(out: Path, data: dict[str, Any]) -> dict[str, bytes]:
     v_all = np.asarray(data["onset_speeds"], float)
     v_all = v_all[v_all > 0]
     if v_all.size:
-        bins = np.geomspace(max(v_all.min(), 1e-6), max(v_all.max(), 2e-6), 50)
+        bins = np.geomspace(max(v_all.min(), 1e-6), max(v_all.max(), 2e-6), 50).tolist()
         ax.hist(v_all, bins=bins, color="0.7", label="all onsets")
         if len(ev):
             ax.hist(ev["normal_speed"], bins=bins, color="C3", alpha=0.7, label="events")

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from typing import Optional
+from typing import Any, Optional
 
 import numpy as np
 from scipy.integrate import quad
@@ -75,7 +75,7 @@ def pair_constants(a: ContactBody, b: ContactBody) -> dict[str, float]:
             "k_h": 4.0 / 3.0 * math.sqrt(r_star) * e_star, "k_r": k_r}
 
 
-def contact_radius(force: np.ndarray, r_star: float, e_star: float) -> np.ndarray:
+def contact_radius(force: Any, r_star: float, e_star: float) -> np.ndarray:
     """Hertz contact radius a = (3 F R* / (4 E*))^{1/3} (m) at force F (N)."""
     f = np.maximum(np.asarray(force, float), 0.0)
     return np.cbrt(3.0 * f * check_positive("r_star", r_star)
@@ -157,6 +157,6 @@ class ImpactLaw:
         """Contact duration (s) at normal impact speeds ``v`` (m/s, > 0)."""
         return self._eval(v, self._lt, lambda x: impact_duration(self.body, self.partner, x))
 
-    def contact_radius(self, force: np.ndarray) -> np.ndarray:
+    def contact_radius(self, force: Any) -> np.ndarray:
         """Hertz contact radius (m) at ``force`` (N) for this pair."""
         return contact_radius(force, self.constants["r_star"], self.constants["e_star"])

@@ -40,7 +40,7 @@ OUTPUT_FILES = ("calibration.json", "table_run.npz", "events.npz", "stress.npz",
                 "events.csv", "cartridges.csv", "risk_arrays.npz", "report.html")
 
 
-def _save_npz(path: Path, **arrays: np.ndarray) -> Path:
+def _save_npz(path: Path, **arrays: Any) -> Path:
     from demfem.io.atomic import atomic_path
 
     with atomic_path(path, suffix=".npz") as tmp:
