@@ -1,0 +1,438 @@
+"""Run the seven-cartridge cluster (paper Figs. 10-13) and write its outputs.
+
+:func:`run_cluster` builds the FEM model of a :class:`demfem.scenes.cluster.CartridgeCluster`,
+runs it (taking ``n_snapshots`` snapshots at regular times, each also written as a VTK
+file), saves the histories to ``run.npz`` and then writes, into ``out``:
+
+* ``forces.csv`` and ``cluster_forces.png`` (Fig. 11): normal and tangential contact force
+  on cartridge 1 from 2 and from 3, split into its bottom (region 0) and top (region 1)
+  halves, N;
+* ``cluster_sigma1.png`` (Fig. 12a,c): σ1 of cartridge 1 against time, the body maximum and
+  the maximum in each contact zone (elements within one division around of the impact
+  direction, bottom or top half);
+* ``cluster_sigma1_through_wall.png`` (Fig. 12b,d): σ1 of the elements on the radial line
+  through the zone's peak element, from the inner to the outer surface, at the snapshot of
+  that pair's largest zone σ1;
+* ``cluster_sigma1_map_1-2_bottom.png`` … (Fig. 13): σ1 on cartridge 1's unrolled outer and
+  inner surface (θ, z) at the snapshot nearest each force peak;
+* ``cluster_sigma1.gif``: the outer-surface σ1 map over time (needs pillow);
+* ``vtk/cluster_NNNN.vtu`` and ``cluster.pvd``: the VTK series (ParaView);
+* ``summary.json``: peaks, wall time, steps, settings (strict JSON).
+
+Resume: the FEM state cannot be checkpointed, so an interrupted run restarts from t = 0;
+once ``run.npz`` is there, a rerun with the same settings only redoes the figures and
+files. Other settings in the same folder are refused unless ``fresh=True``.
+"""
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import shutil
+import time as _time
+from pathlib import Path
+from typing import Any, Callable, Optional, Union
+
+import numpy as np
+
+from demfem.errors import (InvalidParameterError, SettingsMismatchError, SimulationInterrupted,
+                           check_positive)
+from demfem.io.atomic import atomic_path, savefig_atomic, write_text_atomic
+from demfem.io.strict_json import write_json_atomic
+from demfem.scenes.cluster import SITE_ANGLES_DEG, CartridgeCluster
+
+__all__ = ["run_cluster", "PAIRS", "REGIONS", "PAPER_VALUES"]
+
+#: The two colliding pairs and the regions of cartridge 1.
+PAIRS = ("2", "3")
+REGIONS = ((0, "bottom"), (1, "top"))
+
+#: What the paper reports for the max case with springs (Figs. 11-12), N and Pa.
+PAPER_VALUES = {"normal_force_bottom_N": 55.0, "normal_force_top_N": 80.0,
+                "tangential_force_bottom_N": 10.0, "tangential_force_top_N": 14.0,
+                "sigma1_peak_Pa": 140e6, "sigma1_through_wall_Pa": 94e6}
+
+#: Moving-average window of the plotted and summarised forces, s.
+SMOOTH_S = 10e-6
+
+Log = Callable[[str], None]
+
+
+def _settings(cluster: CartridgeCluster, duration: float, n_snapshots: int) -> dict:
+    return json.loads(json.dumps({"cluster": cluster.to_dict(), "duration_s": duration,
+                                  "n_snapshots": n_snapshots}))
+
+
+def _diff(a: Any, b: Any, prefix: str = "") -> list[str]:
+    if isinstance(a, dict) and isinstance(b, dict):
+        out = []
+        for k in sorted(set(a) | set(b)):
+            out += _diff(a.get(k), b.get(k), f"{prefix}{k}.")
+        return out
+    return [] if a == b else [f"{prefix[:-1]} ({b!r} there, {a!r} now)"]
+
+
+def run_cluster(cluster: CartridgeCluster, duration: float = 3e-3,
+                out: Union[str, Path] = "demfem_out/cluster", progress: bool = True,
+                n_snapshots: int = 40, fresh: bool = False,
+                log: Optional[Log] = None) -> dict:
+    """Run ``cluster`` for ``duration`` s and write every output into ``out``; returns the
+    summary (also ``out/summary.json``). See the module text for the files."""
+    if not isinstance(cluster, CartridgeCluster):
+        raise InvalidParameterError(f"invalid cluster = {cluster!r}: must be a CartridgeCluster")
+    duration = check_positive("duration", duration)
+    if duration > 1.0:
+        raise InvalidParameterError(f"invalid duration = {duration!r}: must be at most 1 s "
+                                    "(an explicit FEM step is ~5e-8 s)")
+    if isinstance(n_snapshots, bool) or not isinstance(n_snapshots, int) or not 1 <= n_snapshots <= 1000:
+        raise InvalidParameterError(f"invalid n_snapshots = {n_snapshots!r}: must be an integer in [1, 1000]")
+    log = log or (lambda line: None)
+    out = Path(out)
+    settings = _settings(cluster, duration, n_snapshots)
+    settings_path, run_path = out / "settings.json", out / "run.npz"
+    if settings_path.exists() and not fresh:
+        try:
+            old = json.loads(settings_path.read_text())
+        except (OSError, ValueError):
+            old = None
+        if old != settings:
+            diffs = _diff(settings, old) if isinstance(old, dict) else ["settings.json unreadable"]
+            raise SettingsMismatchError(
+                f"{out} holds a cluster run with other settings: {'; '.join(diffs[:5])} "
+                "(use another --out, or --fresh to replace it)")
+    if fresh and out.exists():
+        for name in ("run.npz", "settings.json", "summary.json", "forces.csv", "cluster.pvd"):
+            (out / name).unlink(missing_ok=True)
+        for p in out.glob("cluster_*"):
+            p.unlink(missing_ok=True)
+        shutil.rmtree(out / "vtk", ignore_errors=True)
+    out.mkdir(parents=True, exist_ok=True)
+    write_json_atomic(settings_path, settings)
+    if run_path.exists():
+        log(f"reusing the finished FEM run in {run_path} (figures and files are redone)")
+        data = dict(np.load(run_path, allow_pickle=False))
+    else:
+        data = _simulate(cluster, duration, n_snapshots, out, progress, log)
+        with atomic_path(run_path, suffix=".npz") as tmp:
+            np.savez_compressed(tmp, **data)
+    return _write_outputs(cluster, data, out, log)
+
+
+# ---------------------------------------------------------------------- the FEM run
+def _simulate(cluster: CartridgeCluster, duration: float, n_snapshots: int, out: Path,
+              progress: bool, log: Log) -> dict:
+    from demfem.fem.result import FemResult, write_pvd
+
+    t_build = _time.perf_counter()
+    parts = cluster.parts()
+    model = cluster.build_model(parts)
+    build_s = _time.perf_counter() - t_build
+    e1 = model.body_elements(0)
+    n1 = model.body_nodes(0)
+    log(f"cluster: {model.mesh.n_elements} tets ({cluster.layers} through the wall, "
+        f"n_theta = {parts.n_theta}), dt = {model.dt_step:.3g} s, about "
+        f"{int(math.ceil(duration / model.dt_step))} steps; springs: {cluster.springs}")
+    bar = None
+    if progress:
+        from demfem.progress import ProgressBar
+        bar = ProgressBar(duration, "cluster")
+    times = [duration * (k + 1) / n_snapshots for k in range(n_snapshots)]
+    vtk = out / "vtk"
+    vtk.mkdir(parents=True, exist_ok=True)
+    energy, snaps_t, sig, press, disp1, frames = [], [], [], [], [], []
+    t_wall = _time.perf_counter()
+    steps0 = int(model.solver.steps)
+    try:
+        for k, t_target in enumerate(times):
+            left = t_target - model.time
+            if left > 0.5 * model.dt_step:
+                cb = (lambda done, t: bar(t, int(model.solver.steps) - steps0)) if bar else False
+                r = model.run(left, progress=cb)
+                if r.energy.size:
+                    energy.append(r.energy)
+            s = model.snapshot()
+            snaps_t.append(s.time)
+            sig.append(s.sigma1_element[e1].astype(np.float32))
+            press.append(s.contact_pressure[n1].astype(np.float32))
+            disp1.append(s.displacement[n1].astype(np.float32))
+            name = f"cluster_{k:04d}.vtu"
+            model.write_vtu(vtk / name)
+            frames.append((s.time, f"vtk/{name}"))
+    except SimulationInterrupted:
+        if bar is not None:
+            bar.close()
+        raise SimulationInterrupted(
+            f"cluster run stopped at t = {model.time * 1e3:.3g} ms of {duration * 1e3:.3g} ms; "
+            "no outputs written (the FEM state cannot be checkpointed: a rerun restarts at "
+            "t = 0)") from None
+    if bar is not None:
+        bar.close()
+    wall = _time.perf_counter() - t_wall
+    write_pvd(out / "cluster.pvd", frames)
+    en = np.vstack(energy) if energy else np.zeros((0, 10))
+    res = FemResult.from_model(model, en, [], 0.0)
+    steps = int(model.solver.steps) - steps0
+    log(f"cluster: {steps} steps in {wall:.1f} s ({steps / max(wall, 1e-9):.1f} steps/s)")
+    data: dict[str, np.ndarray] = {"time": res.time}
+    for kk in PAIRS:
+        for r, rname in REGIONS:
+            c = res.channel("1", kk, r)
+            data[f"fn_1{kk}_{rname}"] = res.normal_force[:, c]
+            data[f"ft_1{kk}_{rname}"] = res.tangential_force[:, c]
+    mesh1 = parts.meshes[0]
+    data.update({
+        "snap_time": np.asarray(snaps_t), "sigma1": np.asarray(sig),
+        "pressure": np.asarray(press), "displacement_1": np.asarray(disp1),
+        "nodes_1": mesh1.nodes, "tets_1": mesh1.tets,
+        "stats": np.array([wall, steps, model.dt_step, model.mesh.n_elements, build_s,
+                           res.energy_balance_error(), parts.spring_stiffness_per_contact,
+                           parts.n_theta], float),
+        "spring_energy": en[:, [0, 6]] if en.size else np.zeros((0, 2)),
+    })
+    return data
+
+
+# ---------------------------------------------------------------------- outputs
+def _geometry(cluster: CartridgeCluster, data: dict) -> dict:
+    nodes, tets = data["nodes_1"], data["tets_1"].astype(np.int64)
+    c = cluster.cartridge
+    cen = nodes[tets].mean(axis=1)
+    r_node = np.hypot(nodes[:, 0], nodes[:, 1])
+    ri, ro = c.radii_at(np.clip(nodes[:, 2] - cluster.lift, 0.0, c.length))
+    tol = 1e-6 * c.body_outer_diameter
+    on_out = np.abs(r_node - ro) < tol
+    on_in = np.abs(r_node - ri) < tol
+    zc = cen[:, 2] - cluster.lift
+    body = zc <= c.body_length
+    return {
+        "theta": np.degrees(np.arctan2(cen[:, 1], cen[:, 0])), "r": np.hypot(cen[:, 0], cen[:, 1]),
+        "z": zc, "outer": (on_out[tets].sum(axis=1) >= 3) & body,
+        "inner": (on_in[tets].sum(axis=1) >= 3) & body,
+        "bottom": zc < 0.5 * c.length, "body": body,
+        "dtheta": 360.0 / float(data["stats"][7]),
+    }
+
+
+def _zone(geo: dict, pair: str, region: int, width: float = 1.0) -> np.ndarray:
+    phi = SITE_ANGLES_DEG[int(pair) - 2]
+    d = (geo["theta"] - phi + 180.0) % 360.0 - 180.0
+    half = geo["bottom"] if region == 0 else ~geo["bottom"]
+    return (np.abs(d) <= width * geo["dtheta"]) & half
+
+
+def _smooth(t: np.ndarray, x: np.ndarray) -> np.ndarray:
+    from demfem.fem.result import moving_average
+    if len(t) < 3:
+        return x
+    w = max(1, int(round(SMOOTH_S / float(np.median(np.diff(t))))))
+    return moving_average(x, w)
+
+
+def _write_outputs(cluster: CartridgeCluster, data: dict, out: Path, log: Log) -> dict:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    t = data["time"]
+    geo = _geometry(cluster, data)
+    ts, sig = data["snap_time"], data["sigma1"].astype(float)
+    written: list[str] = []
+
+    # forces.csv + Fig. 11
+    cols = [f"{kind}_1{p}_{r}" for p in PAIRS for kind in ("fn", "ft") for _, r in REGIONS]
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(["time_s"] + [c + "_N" for c in cols])
+    for i in range(len(t)):
+        w.writerow([f"{t[i]:.9g}"] + [f"{data[c][i]:.6g}" for c in cols])
+    write_text_atomic(out / "forces.csv", buf.getvalue())
+    written.append("forces.csv")
+    fig, axes = plt.subplots(2, 2, figsize=(10, 7), sharex=True)
+    peaks: dict[str, dict] = {}
+    for col, p in enumerate(PAIRS):
+        for row, kind in enumerate(("fn", "ft")):
+            ax = axes[row, col]
+            for r, rname in REGIONS:
+                x = data[f"{kind}_1{p}_{rname}"]
+                xs = _smooth(t, x)
+                line, = ax.plot(t * 1e3, xs, label=f"{rname}")
+                ax.plot(t * 1e3, x, color=line.get_color(), alpha=0.25, lw=0.6)
+                k = int(np.argmax(xs)) if len(xs) else 0
+                peaks.setdefault(f"1-{p}_{rname}", {})[
+                    "normal_N" if kind == "fn" else "tangential_N"] = float(xs[k]) if len(xs) else 0.0
+                if kind == "fn":
+                    peaks[f"1-{p}_{rname}"]["time_s"] = float(t[k]) if len(t) else 0.0
+                    peaks[f"1-{p}_{rname}"]["raw_normal_N"] = float(x.max()) if len(x) else 0.0
+            ax.set_title(f"{'normal' if kind == 'fn' else 'tangential'} force, pair 1-{p}")
+            ax.set_ylabel("force (N)")
+            ax.legend(fontsize=8)
+            ax.grid(alpha=0.3)
+    for ax in axes[1]:
+        ax.set_xlabel("time (ms)")
+    fig.suptitle(f"cluster '{cluster.case}', springs {'on' if cluster.springs else 'off'} "
+                 f"(smoothed over {SMOOTH_S * 1e6:g} us; raw faint)")
+    fig.tight_layout()
+    savefig_atomic(fig, out / "cluster_forces.png", dpi=110)
+    plt.close(fig)
+    written.append("cluster_forces.png")
+
+    # Fig. 12a,c: sigma1 vs time
+    body_max = sig[:, geo["body"]].max(axis=1) if sig.size else np.zeros(0)
+    zone_max = {}
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    ax.plot(ts * 1e3, body_max / 1e6, "k-", label="body maximum")
+    for p in PAIRS:
+        for r, rname in REGIONS:
+            zm = sig[:, _zone(geo, p, r)].max(axis=1)
+            zone_max[(p, r)] = zm
+            ax.plot(ts * 1e3, zm / 1e6, marker=".", label=f"contact 1-{p} {rname}")
+    ax.set_xlabel("time (ms)")
+    ax.set_ylabel(r"$\sigma_1$ (MPa)")
+    ax.set_title(r"max principal stress $\sigma_1$ on cartridge 1")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    savefig_atomic(fig, out / "cluster_sigma1.png", dpi=110)
+    plt.close(fig)
+    written.append("cluster_sigma1.png")
+
+    # Fig. 12b,d: through the wall at each pair's peak
+    c = cluster.cartridge
+    ri = 0.5 * c.body_outer_diameter - c.wall_thickness
+    through: dict[str, dict] = {}
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    for p in PAIRS:
+        best = max(((zone_max[(p, r)].max(), r) for r, _ in REGIONS))
+        r = best[1]
+        k = int(np.argmax(zone_max[(p, r)]))
+        zmask = _zone(geo, p, r)
+        idx = np.flatnonzero(zmask)
+        e_star = idx[int(np.argmax(sig[k, idx]))]
+        line = _zone(geo, p, r, width=0.5) & (np.abs(geo["z"] - geo["z"][e_star]) <=
+                                              0.6 * cluster.element_size())
+        sel = np.flatnonzero(line)
+        order = np.argsort(geo["r"][sel])
+        depth = (geo["r"][sel][order] - ri) / c.wall_thickness
+        vals = sig[k, sel][order]
+        ax.plot(depth, vals / 1e6, "o-", label=f"1-{p} {REGIONS[r][1]}, t = {ts[k] * 1e3:.3g} ms")
+        through[f"1-{p}"] = {"region": REGIONS[r][1], "time_s": float(ts[k]),
+                             "z_m": float(geo["z"][e_star]),
+                             "depth_fraction": depth.tolist(), "sigma1_Pa": vals.tolist(),
+                             "inner_sigma1_Pa": float(vals[0]) if len(vals) else None,
+                             "outer_sigma1_Pa": float(vals[-1]) if len(vals) else None}
+    ax.axhline(0, color="k", lw=0.5)
+    ax.set_xlabel("position through the wall: 0 inner surface, 1 outer surface")
+    ax.set_ylabel(r"$\sigma_1$ (MPa)")
+    ax.set_title(r"$\sigma_1$ through the wall at the contact, at the peak")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    savefig_atomic(fig, out / "cluster_sigma1_through_wall.png", dpi=110)
+    plt.close(fig)
+    written.append("cluster_sigma1_through_wall.png")
+
+    # Fig. 13: unrolled maps at the force peaks
+    maps: dict[str, dict] = {}
+    vlim = float(np.percentile(np.abs(sig[:, geo["body"]]), 99.9)) if sig.size else 1.0
+    for p in PAIRS:
+        for r, rname in REGIONS:
+            key = f"1-{p}_{rname}"
+            tk = peaks[key]["time_s"]
+            k = int(np.argmin(np.abs(ts - tk)))
+            name = f"cluster_sigma1_map_1-{p}_{rname}.png"
+            fig = _map_figure(plt, geo, sig[k], vlim, SITE_ANGLES_DEG[int(p) - 2],
+                              f"pair 1-{p} {rname}: force peak {tk * 1e3:.3g} ms, "
+                              f"snapshot {ts[k] * 1e3:.3g} ms")
+            savefig_atomic(fig, out / name, dpi=100)
+            plt.close(fig)
+            written.append(name)
+            zone = _zone(geo, p, r)
+            maps[key] = {"snapshot_time_s": float(ts[k]),
+                         "outer_zone_min_sigma1_Pa": float(sig[k, zone & geo["outer"]].min()),
+                         "inner_zone_max_sigma1_Pa": float(sig[k, zone & geo["inner"]].max()),
+                         "file": name}
+
+    # GIF
+    gif_note = _write_gif(plt, geo, ts, sig, vlim, out)
+    if gif_note is None:
+        written.append("cluster_sigma1.gif")
+    else:
+        log(gif_note)
+
+    stats = data["stats"]
+    k_peak = int(np.argmax(body_max)) if len(body_max) else 0
+    summary = {
+        "case": cluster.case, "springs": cluster.springs, "elements": cluster.elements,
+        "layers": int(cluster.layers), "v2_m_s": cluster.v2, "v3_m_s": cluster.v3,
+        "direction_2_deg": cluster.direction_2_deg, "direction_3_deg": cluster.direction_3_deg,
+        "E_Pa": cluster.material.E, "duration_s": float(ts[-1]) if len(ts) else 0.0,
+        "wall_time_s": float(stats[0]), "steps": int(stats[1]),
+        "steps_per_s": float(stats[1] / stats[0]) if stats[0] > 0 else None,
+        "dt_s": float(stats[2]), "n_elements": int(stats[3]), "n_theta": int(stats[7]),
+        "energy_balance_error": float(stats[5]),
+        "spring_stiffness_per_contact_N_m": float(stats[6]),
+        "force_peaks": peaks, "smoothing_s": SMOOTH_S,
+        "sigma1_body_max_Pa": float(body_max.max()) if len(body_max) else None,
+        "sigma1_body_max_time_s": float(ts[k_peak]) if len(ts) else None,
+        "sigma1_zone_max_Pa": {f"1-{p}_{rn}": float(zone_max[(p, r)].max())
+                               for p in PAIRS for r, rn in REGIONS},
+        "through_wall": through, "maps": maps, "paper": PAPER_VALUES,
+        "files": written + ["summary.json", "cluster.pvd", "vtk/"],
+        "gif_note": gif_note,
+    }
+    write_json_atomic(out / "summary.json", summary)
+    return summary
+
+
+def _map_figure(plt, geo: dict, s: np.ndarray, vlim: float, phi: float, title: str):
+    from matplotlib.tri import Triangulation
+
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4.2), sharey=True)
+    for ax, which in zip(axes, ("outer", "inner")):
+        m = geo[which]
+        th = (geo["theta"][m] - phi + 180.0) % 360.0 - 180.0  # impact direction at 0
+        tri = Triangulation(th, geo["z"][m] * 1e3)
+        pc = ax.tripcolor(tri, s[m] / 1e6, shading="gouraud", cmap="coolwarm",
+                          vmin=-vlim / 1e6, vmax=vlim / 1e6)
+        ax.axvline(0.0, color="k", lw=1.5)
+        ax.annotate("impact", (0, 0.98), xycoords=("data", "axes fraction"), ha="center",
+                    va="top", fontsize=8, arrowprops=None)
+        ax.set_xlabel("angle from the impact direction (deg)")
+        ax.set_title(f"{which} surface")
+    axes[0].set_ylabel("height z (mm)")
+    fig.colorbar(pc, ax=axes, label=r"$\sigma_1$ (MPa)")
+    fig.suptitle(title, fontsize=10)
+    return fig
+
+
+def _write_gif(plt, geo: dict, ts: np.ndarray, sig: np.ndarray, vlim: float, out: Path) -> Optional[str]:
+    try:
+        import PIL  # noqa: F401
+    except ImportError:
+        return "cluster_sigma1.gif skipped: pillow is not installed (pip install pillow)"
+    from matplotlib.animation import FuncAnimation, PillowWriter
+    from matplotlib.tri import Triangulation
+
+    m = geo["outer"]
+    tri = Triangulation(geo["theta"][m], geo["z"][m] * 1e3)
+    fig, ax = plt.subplots(figsize=(7, 3.6))
+    pc = ax.tripcolor(tri, sig[0, m] / 1e6, shading="gouraud", cmap="coolwarm",
+                      vmin=-vlim / 1e6, vmax=vlim / 1e6)
+    for p in PAIRS:
+        ax.axvline(SITE_ANGLES_DEG[int(p) - 2], color="k", lw=0.8)
+    fig.colorbar(pc, ax=ax, label=r"$\sigma_1$ (MPa)")
+    ax.set_xlabel("angle around cartridge 1 (deg; 2 at 180, 3 at 120)")
+    ax.set_ylabel("z (mm)")
+    title = ax.set_title("")
+
+    def frame(k: int):
+        pc.set_array(sig[k, m] / 1e6)
+        title.set_text(f"outer surface of 1, t = {ts[k] * 1e3:.3f} ms")
+        return pc, title
+
+    anim = FuncAnimation(fig, frame, frames=len(ts), blit=False)
+    with atomic_path(out / "cluster_sigma1.gif", suffix=".gif") as tmp:
+        anim.save(str(tmp), writer=PillowWriter(fps=8))
+    plt.close(fig)
+    return None
