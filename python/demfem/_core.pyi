@@ -15,7 +15,7 @@ __all__ = [
     "FemTetSolver",
     "RigidSimulation",
     "fem_element_stresses",
-    "fem_shell_mesh",
+    "fem_ball_mesh", "fem_shell_mesh",
     "fem_solve_static",
     "fem_stress_invariants",
     "fem_tet_mesh",
@@ -199,6 +199,9 @@ def fem_tet_mesh(
     """Revolved linear-tet mesh of the axisymmetric body (stations z, radii in m):
     (nodes (N,3) m, tets (E,4), quality dict). Slivers below min_dihedral_deg are refused."""
 
+def fem_ball_mesh(radius: float, n: int) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]:
+    """Tet mesh of a ball of ``radius`` m (2n cells across): (nodes (N,3) m, tets (E,4))."""
+
 def fem_shell_mesh(
     z: npt.NDArray[np.float64],
     r_in: npt.NDArray[np.float64],
@@ -282,6 +285,28 @@ class FemTetSolver:
     def element_stresses(self) -> npt.NDArray[np.float64]: ...
     def nodal_stresses(self) -> npt.NDArray[np.float64]: ...
     def write_vtu(self, path: str | os.PathLike[str]) -> None: ...
+    def set_contact(
+        self,
+        body_of_node: npt.NDArray[np.int64],
+        region_of_node: npt.NDArray[np.int64],
+        penalty_scale: float = 1.0,
+        friction: float = 0.2,
+        margin: float | None = None,
+        contacts_per_node: float = 1.0,
+        initial_overlap_tolerance: float = 1e-9,
+        output_interval: int = 10,
+        rigid_surfaces: list[tuple[Any, ...]] = ...,
+        spring_nodes: npt.NDArray[np.int64] | None = None,
+        spring_anchors: npt.NDArray[np.float64] | None = None,
+        spring_stiffness: npt.NDArray[np.float64] | None = None,
+        spring_rest_length: npt.NDArray[np.float64] | None = None,
+    ) -> None:
+        """Penalty contact between the bodies (k = s K A²/V), rigid surfaces, no-tension springs."""
+    def contact_channels(self) -> list[tuple[int, int, int]]: ...
+    def contact_history(self) -> npt.NDArray[np.float64]: ...
+    def contact_pressure(self) -> npt.NDArray[np.float64]: ...
+    def contact_info(self) -> dict[str, Any] | None: ...
+    def mass(self) -> npt.NDArray[np.float64]: ...
 
 @final
 class RigidSimulation:

@@ -76,9 +76,9 @@ def _fields(c: Cartridge) -> dict:
 
 
 def plot_force_vs_modulus(table: CalibrationTable, path: "str | Path",
-                          fem: Optional[tuple[np.ndarray, np.ndarray]] = None) -> Path:
+                          fem: "Optional[tuple[np.ndarray, np.ndarray] | dict[str, tuple[np.ndarray, np.ndarray]]]" = None) -> Path:
     """Write the Fig. 3 analogue (log–log force against E) as a PNG at ``path``.
-    ``fem`` = (E, F) adds FEM points when available."""
+    ``fem`` = (E, F), or {label: (E, F)}, adds FEM points (E in Pa, F in N)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -91,8 +91,9 @@ def plot_force_vs_modulus(table: CalibrationTable, path: "str | Path",
     for i, m in enumerate(table.models):
         ax.loglog(table.E, table.forces[i], styles[m], lw=2 if m == "hertz_reissner" else 1.4,
                   label=labels[m])
-    if fem is not None:
-        ax.loglog(fem[0], fem[1], "ko", label="FEM (two cartridges)")
+    curves = {"FEM (two cartridges)": fem} if isinstance(fem, tuple) else (fem or {})
+    for (label, (e_fem, f_fem)), mark in zip(curves.items(), ("ko", "ks", "k^", "kv")):
+        ax.loglog(e_fem, f_fem, mark, mfc="none" if mark != "ko" else "k", label=label)
     ax.set_xlabel("Young's modulus E [Pa]")
     ax.set_ylabel("maximum contact force [N]")
     ax.set_title(f"Two cartridges colliding at v_rel = {table.v_rel:g} m/s")
@@ -129,11 +130,13 @@ def calibration_report(v_rel: float = 0.2) -> str:
     ])
 
 
-def write_calibration(out_dir: "str | Path", table: CalibrationTable) -> tuple[Path, Path]:
-    """Write ``calibration.csv`` and ``calibration_force_vs_E.png`` into ``out_dir``."""
+def write_calibration(out_dir: "str | Path", table: CalibrationTable,
+                      fem: "Optional[dict[str, tuple[np.ndarray, np.ndarray]]]" = None) -> tuple[Path, Path]:
+    """Write ``calibration.csv`` and ``calibration_force_vs_E.png`` into ``out_dir``;
+    ``fem`` ({label: (E Pa, F N)}) adds FEM curves to the plot."""
     out_dir = Path(out_dir)
     csv = write_text_atomic(out_dir / "calibration.csv", table.to_csv())
-    png = plot_force_vs_modulus(table, out_dir / "calibration_force_vs_E.png")
+    png = plot_force_vs_modulus(table, out_dir / "calibration_force_vs_E.png", fem)
     return csv, png
 
 

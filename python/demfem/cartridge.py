@@ -185,6 +185,16 @@ class Cartridge:
                 f"flange_length = {self.length - self.body_length:g}"
             )
 
+    @classmethod
+    def tube(cls, outer_diameter: float, wall_thickness: float, length: float,
+             material: Material = PAPER_GLASS) -> "Cartridge":
+        """A plain open tube of ``outer_diameter``, ``wall_thickness`` and ``length`` (m): a
+        cartridge without shoulder, neck or flange."""
+        return cls(body_outer_diameter=outer_diameter, wall_thickness=wall_thickness,
+                   length=length, shoulder_length=0.0, neck_outer_diameter=outer_diameter,
+                   neck_length=0.0, flange_outer_diameter=outer_diameter, flange_length=0.0,
+                   flange_chamfer=0.0, material=material)
+
     # ------------------------------------------------------------------ geometry
     @property
     def body_length(self) -> float:

@@ -15,7 +15,9 @@ use demfem::fem::{
 };
 use demfem::DemfemError;
 
+use crate::fem_contact::{self, PyRigid};
 use crate::PyDemfemError;
+use demfem::fem::contact::ContactSettings;
 
 type Nodes<'py> = Bound<'py, PyArray2<f64>>;
 
@@ -132,6 +134,18 @@ fn fem_tet_mesh<'py>(
     d.set_item("min_volume", q.min_volume)?;
     d.set_item("n_elements", q.n_elements)?;
     Ok((arr3(py, &rm.mesh.nodes)?, idx_arr(py, &rm.mesh.tets)?, d))
+}
+
+/// Tet mesh of a ball of `radius` m centred at the origin (a 2n×2n×2n cube mapped onto
+/// the sphere). Returns (nodes (N,3) m, tets (E,4) int64).
+#[pyfunction]
+fn fem_ball_mesh<'py>(
+    py: Python<'py>,
+    radius: f64,
+    n: usize,
+) -> PyResult<(Nodes<'py>, Bound<'py, PyArray2<i64>>)> {
+    let m = demfem::fem::mesh::ball_tet_mesh(radius, n).map_err(PyDemfemError::from)?;
+    Ok((arr3(py, &m.nodes)?, idx_arr(py, &m.tets)?))
 }
 
 /// Mid-surface triangle shell mesh. Returns (nodes (N,3) m, triangles (T,3) int64,
@@ -419,6 +433,97 @@ impl FemTetSolver {
         )
     }
 
+    /// Attach contact (before the first step): bodies numbered per node (`body_of_node`),
+    /// output regions per node, penalty scale s (k = s·K·A²/V), friction μ between bodies,
+    /// broad-phase margin (m), rigid surfaces as tuples ("plane", point, normal,
+    /// surface_velocity, μ), ("sphere", centre, radius, velocity, μ) or ("cylinder", point,
+    /// radius, axis, μ), and optional no-tension springs (nodes, anchors (m,3) m, stiffness
+    /// N/m, rest length m). The stable step is re-certified with the contact included.
+    #[pyo3(signature = (body_of_node, region_of_node, penalty_scale=1.0, friction=0.2, margin=None, contacts_per_node=1.0, initial_overlap_tolerance=1e-9, output_interval=10, rigid_surfaces=Vec::new(), spring_nodes=None, spring_anchors=None, spring_stiffness=None, spring_rest_length=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn set_contact(
+        &mut self,
+        py: Python<'_>,
+        body_of_node: PyReadonlyArray1<'_, i64>,
+        region_of_node: PyReadonlyArray1<'_, i64>,
+        penalty_scale: f64,
+        friction: f64,
+        margin: Option<f64>,
+        contacts_per_node: f64,
+        initial_overlap_tolerance: f64,
+        output_interval: usize,
+        rigid_surfaces: Vec<PyRigid>,
+        spring_nodes: Option<PyReadonlyArray1<'_, i64>>,
+        spring_anchors: Option<PyReadonlyArray2<'_, f64>>,
+        spring_stiffness: Option<PyReadonlyArray1<'_, f64>>,
+        spring_rest_length: Option<PyReadonlyArray1<'_, f64>>,
+    ) -> PyResult<()> {
+        let settings = ContactSettings {
+            penalty_scale,
+            friction,
+            margin,
+            contacts_per_node,
+            initial_overlap_tolerance,
+            output_interval,
+        };
+        let c = fem_contact::build(
+            &self.mesh,
+            &self.material,
+            body_of_node,
+            region_of_node,
+            settings,
+            rigid_surfaces,
+            spring_nodes,
+            spring_anchors,
+            spring_stiffness,
+            spring_rest_length,
+        )?;
+        let inner = &mut self.inner;
+        py.detach(|| inner.set_contact(c))
+            .map_err(PyDemfemError::from)?;
+        Ok(())
+    }
+
+    /// Contact output channels: list of (party a, party b, region of a), a < b (bodies
+    /// first, then rigid surfaces in the order given).
+    fn contact_channels(&self) -> Vec<(usize, usize, usize)> {
+        self.inner.contact().map(|c| c.channels()).unwrap_or_default()
+    }
+    /// Contact history (samples, 1 + 4·channels): time s, then per channel the normal and
+    /// tangential resultant force N, contact area m², largest penetration m.
+    fn contact_history<'py>(&self, py: Python<'py>) -> PyResult<Nodes<'py>> {
+        let (h, w) = match self.inner.contact() {
+            Some(c) => (c.history().to_vec(), 1 + 4 * c.channels().len()),
+            None => (Vec::new(), 1),
+        };
+        let rows = h.len() / w;
+        let a = Array2::from_shape_vec((rows, w), h)
+            .map_err(|e| shape_err("contact history", e.to_string()))?;
+        Ok(a.into_pyarray(py))
+    }
+    /// Contact pressure per node in the last step, Pa (N,).
+    fn contact_pressure<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        let p = self
+            .inner
+            .contact()
+            .map(|c| c.pressure())
+            .unwrap_or_else(|| vec![0.0; self.mesh.nodes.len()]);
+        p.into_pyarray(py)
+    }
+    /// Contact energies (J) and counters: elastic_energy, spring_energy, friction_work,
+    /// rigid_work, contact_work, bookkeeping_error, active_contacts, broad_phase_builds,
+    /// eigenvalue_allowance (1/s²), max_contact_eigenvalue (1/s²), dt_limit_without_contact (s).
+    fn contact_info<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        match self.inner.contact() {
+            Some(c) => Ok(Some(fem_contact::info(py, c, self.inner.dt_limit_without_contact())?)),
+            None => Ok(None),
+        }
+    }
+    /// Lumped nodal masses (N,), kg.
+    fn mass<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.inner.mass().to_vec().into_pyarray(py)
+    }
+
     /// Time step in use, s.
     #[getter]
     fn dt(&self) -> f64 {
@@ -495,6 +600,11 @@ impl FemTetSolver {
         let s1: Vec<f64> = ns.iter().map(stress::max_principal_stress).collect();
         let s1e: Vec<f64> = es.iter().map(stress::max_principal_stress).collect();
         let nsf: Vec<f64> = ns.iter().flatten().cloned().collect();
+        let pressure = self
+            .inner
+            .contact()
+            .map(|c| c.pressure())
+            .unwrap_or_else(|| vec![0.0; self.mesh.nodes.len()]);
         write_vtu(
             &path,
             &self.mesh.nodes,
@@ -520,6 +630,11 @@ impl FemTetSolver {
                     n_components: 1,
                     values: &s1,
                 },
+                DataArray {
+                    name: "contact_pressure",
+                    n_components: 1,
+                    values: &pressure,
+                },
             ],
             &[DataArray {
                 name: "sigma1_element",
@@ -539,6 +654,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fem_solve_static, m)?)?;
     m.add_function(wrap_pyfunction!(fem_element_stresses, m)?)?;
     m.add_function(wrap_pyfunction!(fem_stress_invariants, m)?)?;
+    m.add_function(wrap_pyfunction!(fem_ball_mesh, m)?)?;
     m.add_class::<FemTetSolver>()?;
     Ok(())
 }

@@ -11,6 +11,7 @@ use demfem::DemfemError;
 
 mod dem;
 mod fem;
+mod fem_contact;
 mod rigid;
 
 /// The one conversion from core errors to Python exceptions: each variant raises the class

@@ -24,6 +24,7 @@
 use rayon::prelude::*;
 
 use crate::error::{check_non_negative, check_open, check_positive, DemfemError, Result};
+use crate::fem::contact::{ContactEnergy, ContactModel};
 use crate::fem::assembly::{lumped_mass, precompute_tets, NodeAdjacency};
 use crate::fem::element::Tet4;
 use crate::fem::material::LinearElastic;
@@ -396,6 +397,9 @@ pub struct ExplicitSolver {
     steps: u64,
     energy: EnergyReport,
     history: Vec<EnergyReport>,
+    contact: Option<ContactModel>,
+    f_contact: Vec<[f64; 3]>,
+    dt_limit_without_contact: f64,
 }
 
 impl ExplicitSolver {
@@ -478,6 +482,9 @@ impl ExplicitSolver {
             steps: 0,
             energy: EnergyReport::default(),
             history: Vec::new(),
+            contact: None,
+            f_contact: Vec::new(),
+            dt_limit_without_contact: dt_limit,
         })
     }
 
@@ -576,6 +583,57 @@ impl ExplicitSolver {
         Ok(())
     }
 
+    /// Attach a contact model (before the first step). The stable step is re-certified
+    /// with the contact's eigenvalue allowance added to the bound (Weyl: λ_max(A + B) ≤
+    /// λ_max(A) + λ_max(B)); an automatic step is reduced to fit, a fixed `dt` above the new
+    /// limit is refused. Bodies overlapping at the start are refused.
+    pub fn set_contact(&mut self, mut contact: ContactModel) -> Result<()> {
+        self.require_start("contact")?;
+        let allowance = contact.eigenvalue_allowance(&self.mass)?;
+        contact.check_initial_overlap(&self.u)?;
+        let limit = critical_step_from_eigenvalue(
+            self.eigen.bound + allowance,
+            self.config.rayleigh_alpha,
+            self.config.rayleigh_beta,
+        )?;
+        let dt = match self.config.dt {
+            Some(dt) if dt > limit => {
+                return Err(DemfemError::UnstableTimeStep {
+                    dt,
+                    limit,
+                    reason: format!(
+                        "element bound {:e} 1/s² plus contact allowance {allowance:e} 1/s²",
+                        self.eigen.bound
+                    ),
+                })
+            }
+            Some(dt) => dt,
+            None => self.config.safety_factor * limit,
+        };
+        self.dt = dt;
+        self.dt_limit = limit;
+        self.f_contact = vec![[0.0; 3]; self.mass.len()];
+        self.contact = Some(contact);
+        Ok(())
+    }
+
+    /// The attached contact model.
+    pub fn contact(&self) -> Option<&ContactModel> {
+        self.contact.as_ref()
+    }
+    /// Contact energies (zero without contact).
+    pub fn contact_energy(&self) -> ContactEnergy {
+        self.contact.as_ref().map(|c| c.energy()).unwrap_or_default()
+    }
+    /// Stable step bound without the contact's allowance, s.
+    pub fn dt_limit_without_contact(&self) -> f64 {
+        self.dt_limit_without_contact
+    }
+    /// Contact forces of the last step, N per node (empty without contact).
+    pub fn contact_force(&self) -> &[[f64; 3]] {
+        &self.f_contact
+    }
+
     /// Time step in use, s.
     pub fn dt(&self) -> f64 {
         self.dt
@@ -650,6 +708,9 @@ impl ExplicitSolver {
     pub fn run(&mut self, n: u64) -> Result<()> {
         for i in 0..n {
             self.step();
+            if let Some(err) = self.contact.as_mut().and_then(|c| c.take_failure()) {
+                return Err(err);
+            }
             if (i + 1) % 64 == 0 || i + 1 == n {
                 self.check_finite()?;
             }
@@ -697,6 +758,10 @@ impl ExplicitSolver {
                 f[2] *= beta;
             }
         }
+        if let Some(c) = self.contact.as_mut() {
+            c.compute(&self.u, &self.v, t, dt, &mut self.f_contact);
+        }
+        let has_contact = self.contact.is_some();
         let lf = self.load_history.factor(t);
         let bf_next = self.bc_history.factor(t + dt);
         // One fused, deterministic pass over nodes: damping and external forces at t^n,
@@ -707,6 +772,7 @@ impl ExplicitSolver {
             let f_int = &self.f_int;
             let loads = &self.loads;
             let extra = &self.extra_loads;
+            let fc = &self.f_contact;
             let bc_kind = &self.bc_kind;
             let bc_value = &self.bc_value;
             self.v
@@ -729,7 +795,11 @@ impl ExplicitSolver {
                             // βK v^{n−½} is in fd when β > 0; add αM v^{n−½}.
                             let stiff = if beta > 0.0 { fd[k][d] } else { 0.0 };
                             let damp = stiff + alpha * m * v_old;
-                            let f_ext = loads[i][d] * lf + extra[i][d];
+                            let f_ext = if has_contact {
+                                loads[i][d] * lf + extra[i][d] + fc[i][d]
+                            } else {
+                                loads[i][d] * lf + extra[i][d]
+                            };
                             fe[k][d] = f_ext;
                             let resid = f_ext - f_int[i][d] - damp;
                             let u_old = uc[k][d];

@@ -3,7 +3,8 @@
 //!
 //! Layout (fenris style): [`mesh`] builds and checks meshes, [`element`] holds the element
 //! kernels, [`assembly`] turns element quantities into global ones (lumped mass, sparse
-//! stiffness, surface loads), [`shell`] assembles and solves thin-shell models, [`explicit`] integrates in time, [`stable_step`] bounds the
+//! stiffness, surface loads), [`contact`] gives bodies penalty contact with each other and
+//! with rigid surfaces, [`shell`] assembles and solves thin-shell models, [`explicit`] integrates in time, [`stable_step`] bounds the
 //! critical time step, [`static_solve`] factorises the sparse stiffness, [`stress`] recovers
 //! stresses and [`io`] writes VTK files. All quantities are SI.
 
@@ -13,6 +14,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod assembly;
+pub mod contact;
 pub mod element;
 pub mod explicit;
 pub mod io;

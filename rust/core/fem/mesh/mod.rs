@@ -8,9 +8,11 @@
 //! so every shared face is cut by the same diagonal from both sides and the mesh is
 //! conforming, including across the periodic seam in θ.
 
+mod compose;
 mod quality;
 mod revolve;
 
+pub use compose::{ball_tet_mesh, place, union};
 pub use quality::{tet_quality, MeshQuality, TetQuality};
 pub use revolve::{box_tet_mesh, AxisymmetricProfile, RevolvedTetMesh};
 

@@ -1,0 +1,142 @@
+"""FEM meshes: tetrahedra through the glass wall and shells on its mid-surface, from any
+:class:`demfem.cartridge.Cartridge`; balls (for verification); placement of a mesh.
+
+Every length is in m. Meshes are plain numpy arrays in frozen dataclasses, so they can be
+saved, inspected and built by hand.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Optional, Sequence
+
+import numpy as np
+
+from demfem import _core
+from demfem.cartridge import Cartridge
+from demfem.errors import InvalidParameterError, check_positive
+
+#: Meshes larger than this are refused unless ``max_elements`` is raised explicitly.
+DEFAULT_MAX_ELEMENTS = 2_000_000
+
+
+@dataclass(frozen=True)
+class TetMesh:
+    """Linear tetrahedra: ``nodes`` (N, 3) m, ``tets`` (E, 4) node indices, positively
+    oriented."""
+
+    nodes: np.ndarray
+    tets: np.ndarray
+
+    @property
+    def n_nodes(self) -> int:
+        return int(self.nodes.shape[0])
+
+    @property
+    def n_elements(self) -> int:
+        return int(self.tets.shape[0])
+
+    def placed(self, rotation: Optional[np.ndarray] = None,
+               translation: Sequence[float] = (0.0, 0.0, 0.0)) -> "TetMesh":
+        """The mesh rotated by the 3×3 proper rotation ``rotation`` about the origin, then
+        moved by ``translation`` (m)."""
+        r = np.eye(3) if rotation is None else np.asarray(rotation, dtype=float)
+        if r.shape != (3, 3) or not np.allclose(r @ r.T, np.eye(3), atol=1e-9) \
+                or not abs(np.linalg.det(r) - 1.0) < 1e-9:
+            raise InvalidParameterError(
+                f"invalid rotation = {r.tolist()!r}: must be a 3x3 proper rotation matrix")
+        t = np.asarray(translation, dtype=float)
+        if t.shape != (3,) or not np.all(np.isfinite(t)):
+            raise InvalidParameterError(f"invalid translation = {translation!r}: must be 3 finite values (m)")
+        return TetMesh(self.nodes @ r.T + t, self.tets)
+
+
+@dataclass(frozen=True)
+class ShellMesh:
+    """Flat shell triangles on the mid-surface: ``nodes`` (N, 3) m, ``triangles`` (T, 3),
+    ``thickness`` (T,) m."""
+
+    nodes: np.ndarray
+    triangles: np.ndarray
+    thickness: np.ndarray
+
+
+def rotation_about(axis: Sequence[float], angle_deg: float) -> np.ndarray:
+    """Rotation matrix (3×3) by ``angle_deg`` degrees about ``axis`` (right-hand rule)."""
+    a = np.asarray(axis, dtype=float)
+    n = np.linalg.norm(a)
+    if not (n > 0 and np.isfinite(n)):
+        raise InvalidParameterError(f"invalid axis = {axis!r}: must be a finite non-zero vector")
+    if not math.isfinite(angle_deg):
+        raise InvalidParameterError(f"invalid angle_deg = {angle_deg!r}: must be finite")
+    x, y, z = a / n
+    t = math.radians(angle_deg)
+    c, s, C = math.cos(t), math.sin(t), 1 - math.cos(t)
+    return np.array([
+        [c + x * x * C, x * y * C - z * s, x * z * C + y * s],
+        [y * x * C + z * s, c + y * y * C, y * z * C - x * s],
+        [z * x * C - y * s, z * y * C + x * s, c + z * z * C],
+    ])
+
+
+def _layers(layers: int) -> int:
+    if isinstance(layers, bool) or not isinstance(layers, (int, np.integer)) or not 1 <= layers <= 16:
+        raise InvalidParameterError(f"invalid layers = {layers!r}: must be an integer in [1, 16]")
+    return int(layers)
+
+
+def _sizes(cartridge: Cartridge, layers: int, target_size: Optional[float],
+           n_theta: Optional[int]) -> tuple[float, int]:
+    t = cartridge.wall_thickness
+    h = 2.0 * t / layers if target_size is None else check_positive("target_size", target_size)
+    if n_theta is None:
+        n_theta = max(12, int(math.ceil(2 * math.pi * 0.5 * cartridge.body_outer_diameter / h)))
+    if isinstance(n_theta, bool) or not isinstance(n_theta, (int, np.integer)) or not 6 <= n_theta <= 4096:
+        raise InvalidParameterError(f"invalid n_theta = {n_theta!r}: must be an integer in [6, 4096]")
+    return h, int(n_theta)
+
+
+def estimated_tet_count(cartridge: Cartridge, layers: int = 2, target_size: Optional[float] = None,
+                        n_theta: Optional[int] = None) -> int:
+    """Elements the revolved tet mesher will make (about): 6 per cell of
+    n_theta × layers × (length / target_size) cells."""
+    layers = _layers(layers)
+    h, n_theta = _sizes(cartridge, layers, target_size, n_theta)
+    return int(6 * n_theta * layers * math.ceil(cartridge.length / h))
+
+
+def cartridge_tet_mesh(cartridge: Cartridge, layers: int = 2, target_size: Optional[float] = None,
+                       n_theta: Optional[int] = None,
+                       max_elements: int = DEFAULT_MAX_ELEMENTS) -> TetMesh:
+    """Revolved tetrahedral mesh of ``cartridge`` with ``layers`` elements through the wall.
+
+    ``target_size`` (m) is the axial and circumferential element size (default: twice the
+    radial size, 2 t / layers); ``n_theta`` the divisions around (default from the target
+    size). The open end is at z = 0, the axis is z. Meshes whose estimated element count
+    exceeds ``max_elements`` are refused before any memory is spent.
+    """
+    layers = _layers(layers)
+    h, n_theta = _sizes(cartridge, layers, target_size, n_theta)
+    est = estimated_tet_count(cartridge, layers, h, n_theta)
+    if est > max_elements:
+        raise InvalidParameterError(
+            f"invalid mesh size: about {est} elements for layers = {layers}, target_size = {h:g} m, "
+            f"n_theta = {n_theta}; must be at most max_elements = {max_elements} (raise it explicitly)")
+    z, ri, ro = cartridge.stations()
+    nodes, tets, _ = _core.fem_tet_mesh(z, ri, ro, n_theta, layers, h)
+    return TetMesh(np.asarray(nodes), np.asarray(tets))
+
+
+def cartridge_shell_mesh(cartridge: Cartridge, target_size: Optional[float] = None,
+                         n_theta: Optional[int] = None) -> ShellMesh:
+    """Mid-surface triangle mesh of ``cartridge`` with the wall thickness per triangle."""
+    h, n_theta = _sizes(cartridge, 1, target_size, n_theta)
+    z, ri, ro = cartridge.stations()
+    nodes, tri, th = _core.fem_shell_mesh(z, ri, ro, n_theta, h)
+    return ShellMesh(np.asarray(nodes), np.asarray(tri), np.asarray(th))
+
+
+def ball_tet_mesh(radius: float, n: int = 6) -> TetMesh:
+    """Tet mesh of a ball of ``radius`` (m) at the origin, 2n cells across (verification)."""
+    nodes, tets = _core.fem_ball_mesh(check_positive("radius", radius), int(n))
+    return TetMesh(np.asarray(nodes), np.asarray(tets))

@@ -1,0 +1,171 @@
+//! Rigid surfaces the FEM bodies can touch: a plane with a surface velocity (the belt),
+//! a sphere and an infinite cylinder (for verification), each with its own Coulomb
+//! friction coefficient. A rigid surface is a party of the contact output like a body.
+
+use crate::error::{check_non_negative, check_positive, DemfemError, Result};
+
+use super::vec3::{dot, norm, scale, sub};
+
+/// The shape of a rigid surface.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum RigidShape {
+    /// The half-space behind the plane through `point` with outward unit `normal`
+    /// (bodies stay on the side the normal points to).
+    Plane {
+        /// A point of the plane, m.
+        point: [f64; 3],
+        /// Unit normal pointing out of the rigid half-space.
+        normal: [f64; 3],
+    },
+    /// A solid sphere whose centre moves at a constant velocity.
+    Sphere {
+        /// Centre at t = 0, m.
+        center: [f64; 3],
+        /// Radius, m.
+        radius: f64,
+        /// Velocity of the centre, m/s.
+        velocity: [f64; 3],
+    },
+    /// A solid infinite cylinder.
+    Cylinder {
+        /// A point of the axis, m.
+        point: [f64; 3],
+        /// Unit axis direction.
+        axis: [f64; 3],
+        /// Radius, m.
+        radius: f64,
+    },
+}
+
+/// A rigid surface with its surface velocity (a belt's motion within its plane; for the
+/// sphere the velocity of its centre) and friction.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RigidSurface {
+    /// Geometry.
+    pub shape: RigidShape,
+    /// Velocity of the surface material, m/s (for a plane, its component along the normal
+    /// is ignored: the plane itself does not move).
+    pub surface_velocity: [f64; 3],
+    /// Coulomb friction coefficient μ ≥ 0 against the bodies.
+    pub friction: f64,
+}
+
+fn unit(field: &str, v: [f64; 3]) -> Result<[f64; 3]> {
+    let n = norm(v);
+    if !(n > 0.0) || !n.is_finite() {
+        return Err(DemfemError::InvalidParameter {
+            field: field.into(),
+            value: format!("{v:?}"),
+            allowed: "a finite non-zero vector".into(),
+        });
+    }
+    Ok(scale(v, 1.0 / n))
+}
+
+fn finite(field: &str, v: [f64; 3]) -> Result<()> {
+    if v.iter().all(|x| x.is_finite()) {
+        Ok(())
+    } else {
+        Err(DemfemError::InvalidParameter {
+            field: field.into(),
+            value: format!("{v:?}"),
+            allowed: "finite".into(),
+        })
+    }
+}
+
+impl RigidSurface {
+    /// Check the values and normalise the directions.
+    pub fn validated(mut self) -> Result<Self> {
+        check_non_negative("friction", self.friction)?;
+        finite("surface_velocity", self.surface_velocity)?;
+        self.shape = match self.shape {
+            RigidShape::Plane { point, normal } => {
+                finite("plane point", point)?;
+                RigidShape::Plane {
+                    point,
+                    normal: unit("plane normal", normal)?,
+                }
+            }
+            RigidShape::Sphere {
+                center,
+                radius,
+                velocity,
+            } => {
+                finite("sphere center", center)?;
+                finite("sphere velocity", velocity)?;
+                check_positive("sphere radius", radius)?;
+                RigidShape::Sphere {
+                    center,
+                    radius,
+                    velocity,
+                }
+            }
+            RigidShape::Cylinder {
+                point,
+                axis,
+                radius,
+            } => {
+                finite("cylinder point", point)?;
+                check_positive("cylinder radius", radius)?;
+                RigidShape::Cylinder {
+                    point,
+                    axis: unit("cylinder axis", axis)?,
+                    radius,
+                }
+            }
+        };
+        Ok(self)
+    }
+
+    /// Penetration d > 0, outward unit normal and surface velocity at `p` at time `t`, or
+    /// `None` when `p` is outside the solid.
+    pub fn probe(&self, p: [f64; 3], t: f64) -> Option<(f64, [f64; 3], [f64; 3])> {
+        match self.shape {
+            RigidShape::Plane { point, normal } => {
+                let g = dot(sub(p, point), normal);
+                if g < 0.0 {
+                    let vs = sub(
+                        self.surface_velocity,
+                        scale(normal, dot(self.surface_velocity, normal)),
+                    );
+                    Some((-g, normal, vs))
+                } else {
+                    None
+                }
+            }
+            RigidShape::Sphere {
+                center,
+                radius,
+                velocity,
+            } => {
+                let c = [
+                    center[0] + velocity[0] * t,
+                    center[1] + velocity[1] * t,
+                    center[2] + velocity[2] * t,
+                ];
+                let r = sub(p, c);
+                let l = norm(r);
+                if l < radius && l > 0.0 {
+                    Some((radius - l, scale(r, 1.0 / l), velocity))
+                } else {
+                    None
+                }
+            }
+            RigidShape::Cylinder {
+                point,
+                axis,
+                radius,
+            } => {
+                let r = sub(p, point);
+                let radial = sub(r, scale(axis, dot(r, axis)));
+                let l = norm(radial);
+                if l < radius && l > 0.0 {
+                    Some((radius - l, scale(radial, 1.0 / l), self.surface_velocity))
+                } else {
+                    None
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,76 @@
+"""demfem.fem: meshes from cartridges, bodies in contact, the belt, ghost springs, the
+two-cartridge collision, and clear errors for bad input."""
+import numpy as np
+import pytest
+
+from demfem.cartridge import Cartridge
+from demfem.errors import DemfemError, InvalidParameterError
+from demfem.fem import (Body, ContactOptions, FemModel, GhostSprings, RigidPlane,
+                        ball_tet_mesh, cartridge_tet_mesh, collide_cartridges,
+                        estimated_tet_count, rotation_about)
+from demfem.materials import Material
+
+SOFT = Material(1e7, 0.3, 1000.0, "soft")
+
+
+def test_tube_and_cartridge_meshes():
+    tube = Cartridge.tube(11.6e-3, 1.1e-3, 20e-3)
+    z, ri, ro = tube.stations()
+    assert list(z) == [0.0, 20e-3] and ri[0] == pytest.approx(4.7e-3) and ro[0] == pytest.approx(5.8e-3)
+    m = cartridge_tet_mesh(tube, layers=2)
+    r = np.hypot(m.nodes[:, 0], m.nodes[:, 1])
+    assert r.min() == pytest.approx(4.7e-3, rel=1e-9) and r.max() == pytest.approx(5.8e-3, rel=1e-9)
+    est = estimated_tet_count(tube, layers=2)
+    assert 0.5 < m.n_elements / est < 2.0
+    with pytest.raises(InvalidParameterError, match="max_elements"):
+        cartridge_tet_mesh(Cartridge(), layers=4, target_size=1e-5)
+    with pytest.raises(InvalidParameterError, match="layers"):
+        cartridge_tet_mesh(tube, layers=0)
+
+
+def test_ball_resting_on_belt_is_carried_and_springs_push():
+    ball = ball_tet_mesh(0.01, 3).placed(None, (0.0, 0.0, 0.01 + 1e-7))
+    belt = RigidPlane(surface_velocity=(0.1, 0.0, 0.0), friction=0.5)
+    model = FemModel([Body(ball, name="ball")], SOFT, rigid=[belt], gravity=(0, 0, -9.81),
+                     rayleigh_beta=2e-5, mass_scaling_dt=1e-6)
+    res = model.run(0.02)
+    assert res.channels[0][:2] == ("ball", "belt")
+    assert res.normal_force[-1, 0] > 0.0
+    assert model.body_velocity(0)[0] > 0.0  # friction drags it along the belt
+    assert np.isfinite(res.energy).all()
+    assert res.step["dt_s"] <= res.step["dt_limit_s"]
+    # A ghost spring on the +x side pushes the body towards −x and never pulls.
+    ball2 = ball_tet_mesh(0.01, 2)
+    far = int(np.argmax(ball2.nodes[:, 0]))
+    springs = GhostSprings(0, np.array([far]), np.array([[0.0125, 0.0, 0.0]]), 50.0, 0.003)
+    m2 = FemModel([Body(ball2)], SOFT, springs=[springs])
+    m2.run(1e-3)
+    assert m2.body_velocity(0)[0] < 0.0
+
+
+def test_collision_of_two_soft_cartridges_conserves_energy():
+    tube = Cartridge.tube(11.6e-3, 1.1e-3, 16e-3, material=SOFT)
+    r = collide_cartridges(tube, tube, v_rel=0.2, tilt_deg=90.0, layers=1)
+    assert r.max_force > 0.0 and r.raw_max_force >= r.max_force
+    assert 0.0 < r.restitution <= 1.0
+    assert r.contact_duration > 0.0
+    assert r.energy_balance_error < 0.01
+    assert r.result.step["reduced_for_contact"] in (True, False)
+
+
+def test_bad_input_names_the_field():
+    ball = ball_tet_mesh(0.01, 2)
+    with pytest.raises(InvalidParameterError, match="friction"):
+        FemModel([Body(ball)], SOFT, contact=ContactOptions(friction=-0.1))
+    with pytest.raises(DemfemError, match="penalty_scale"):
+        FemModel([Body(ball)], SOFT, contact=ContactOptions(penalty_scale=0.0))
+    with pytest.raises(DemfemError, match="overlap"):
+        FemModel([Body(ball), Body(ball.placed(None, (0.005, 0, 0)))], SOFT)
+    with pytest.raises(DemfemError, match="stiffness"):
+        FemModel([Body(ball)], SOFT, springs=[GhostSprings(0, np.array([0]), np.zeros((1, 3)) + 1, -1.0, 0.01)])
+    with pytest.raises(InvalidParameterError, match="rotation"):
+        ball.placed(np.ones((3, 3)))
+    with pytest.raises(InvalidParameterError, match="v_rel"):
+        collide_cartridges(v_rel=-1.0)
+    r = rotation_about((1, 0, 0), 90.0)
+    assert np.allclose(r @ [0, 0, 1], [0, -1, 0])
