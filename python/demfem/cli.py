@@ -49,7 +49,26 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     table = force_vs_modulus(Cartridge(), E, args.v_rel)
     print(f"\nMaximum contact force, two cartridges at v_rel = {args.v_rel:g} m/s (Fig. 3 analogue):")
     print(table.format())
-    csv, png = write_calibration(args.out, table)
+    from pathlib import Path
+
+    from demfem.fem import fig3
+
+    if args.fem:
+        print(f"\nFEM: two cartridges colliding at {args.v_rel:g} m/s (explicit, contact), this takes minutes")
+        data = fig3.fem_force_vs_modulus(E=[float(e) for e in np.logspace(7, 11, 5)], v_rel=args.v_rel)
+        stored = fig3.save(data, Path(args.out) / "fig3_fem.json")
+        print(f"wrote {stored}")
+    else:
+        data = fig3.load_stored()
+    curves = {"FEM, crossed (tilt 90 deg)": fig3.curve(data, 90.0),
+              "FEM, parallel (tilt 0 deg)": fig3.curve(data, 0.0)}
+    curves = {k: v for k, v in curves.items() if len(v[0])}
+    print(f"FEM points ({'computed now' if args.fem else 'stored run, --fem recomputes'}):")
+    for r in sorted(data["runs"], key=lambda r: (r["tilt_deg"], r["E_Pa"])):
+        print(f"  tilt {r['tilt_deg']:4.0f} deg  E {r['E_Pa']:9.2e} Pa  FEM {r['max_force_N']:8.3f} N"
+              f"  Hertz-Reissner {r['hertz_reissner_N']:8.3f} N"
+              f"  ({100 * (r['hertz_reissner_N'] / r['max_force_N'] - 1):+.0f} %)")
+    csv, png = write_calibration(args.out, table, curves)
     print(f"\nwrote {csv}\nwrote {png}")
     return 0
 
@@ -199,6 +218,39 @@ def _cmd_assess(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_cluster(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from demfem.scenes.cluster import LOAD_CASES, CartridgeCluster
+    from demfem.studies.cluster_run import run_cluster
+
+    overrides = {"springs": args.springs}
+    if args.elements is not None:
+        overrides["elements"] = args.elements
+    if args.layers is not None:
+        overrides["layers"] = args.layers
+    if args.case in LOAD_CASES:
+        cluster = CartridgeCluster.load_case(args.case, **overrides)
+    elif args.case.endswith(".toml"):
+        import dataclasses
+
+        base = CartridgeCluster.from_toml(Path(args.case))
+        if not args.springs:
+            overrides.pop("springs")
+        cluster = dataclasses.replace(base, **overrides)
+    else:
+        raise InvalidParameterError(f"invalid --case {args.case!r}: must be max, avg or a "
+                                    "SCENE.toml file")
+    s = run_cluster(cluster, duration=args.duration, out=args.out, progress=True,
+                    n_snapshots=args.snapshots, fresh=args.fresh,
+                    log=lambda line: print(line, flush=True))
+    fp = s["force_peaks"]
+    print("peak normal / tangential force on 1 (N): " + "; ".join(
+        f"{k} {v['normal_N']:.3g} / {v['tangential_N']:.3g}" for k, v in fp.items()))
+    print(f"peak sigma1 on 1: {s['sigma1_body_max_Pa'] / 1e6:.4g} MPa; outputs in {args.out}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``demfem`` command."""
     p = _Parser(prog="demfem", description="DEM-FEM breakage of glass cartridges on a "
@@ -211,6 +263,9 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--e-max", type=float, default=1e11, help="largest Young's modulus, Pa (1e11)")
     c.add_argument("--n", type=int, default=9, help="number of moduli, log-spaced (9)")
     c.add_argument("--out", default="demfem_out", help="output directory (demfem_out)")
+    c.add_argument("--fem", action="store_true",
+                   help="recompute the FEM curve (two cartridges colliding; minutes) instead of "
+                        "drawing the stored run")
     c.set_defaults(func=_cmd_calibrate)
     r = sub.add_parser("run", help="the main job: calibration, DEM of a table scene, analysis")
     r.add_argument("scene", nargs="?", default=None, metavar="SCENE.toml",
@@ -283,6 +338,26 @@ def build_parser() -> argparse.ArgumentParser:
     a.add_argument("--fresh", "--overwrite", dest="fresh", action="store_true",
                    help="replace the assessment in --out (its outputs are removed)")
     a.set_defaults(func=_cmd_assess)
+    cl = sub.add_parser("cluster", help="FEM of the seven-cartridge cluster (Figs. 10-13): "
+                        "forces, sigma1, maps, VTK")
+    cl.add_argument("--case", default="max", metavar="max|avg|SCENE.toml",
+                    help="load case: max (V2 0.18, V3 0.12 m/s), avg (0.05, 0.025) or a "
+                         "cluster scene file (default max)")
+    cl.add_argument("--springs", action="store_true",
+                    help="hold 4-7 by no-tension springs to ghost neighbours")
+    cl.add_argument("--elements", default=None, choices=("tet", "shell"),
+                    help="element type (tet; shell has no contact solver yet)")
+    cl.add_argument("--layers", type=int, default=None,
+                    help="tet layers through the wall, 1-4 (2)")
+    cl.add_argument("--duration", type=float, default=3e-3, help="simulated time, s (3e-3)")
+    cl.add_argument("--snapshots", type=int, default=40,
+                    help="snapshots (sigma1, VTK) at regular times (40)")
+    cl.add_argument("--out", default="demfem_out/cluster", help="output directory "
+                    "(demfem_out/cluster); a finished run there with the same settings is "
+                    "reused, other settings are refused")
+    cl.add_argument("--fresh", "--overwrite", dest="fresh", action="store_true",
+                    help="replace the cluster run in --out")
+    cl.set_defaults(func=_cmd_cluster)
     return p
 
 

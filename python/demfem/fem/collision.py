@@ -44,6 +44,14 @@ class CollisionResult:
     result: FemResult
 
 
+def _division_deg(mesh) -> float:
+    """The angle between neighbouring node columns of a revolved mesh, degrees."""
+    r = np.hypot(mesh.nodes[:, 0], mesh.nodes[:, 1])
+    outer = mesh.nodes[r > r.max() * (1 - 1e-9)]
+    th = np.unique(np.round(np.degrees(np.arctan2(outer[:, 1], outer[:, 0])) % 360.0, 9))
+    return float(np.min(np.diff(th))) if th.size > 1 else 0.0
+
+
 def collide_cartridges(a: Optional[Cartridge] = None, b: Optional[Cartridge] = None,
                        material: Optional[Material] = None, v_rel: float = 0.2,
                        tilt_deg: float = 90.0, layers: int = 2, elements: str = "tet",
@@ -69,6 +77,11 @@ def collide_cartridges(a: Optional[Cartridge] = None, b: Optional[Cartridge] = N
             "no explicit contact solver in demfem yet)")
     ma = cartridge_tet_mesh(a, layers=layers, target_size=target_size)
     mb = cartridge_tet_mesh(b, layers=layers, target_size=target_size)
+    # Turn each tube about its own axis by half a division, so a face (not an edge of the
+    # faceted surface) faces the other tube: node-to-surface contact does not see two
+    # edges crossing (that needs edge-to-edge contact, which demfem does not have).
+    ma = ma.placed(rotation_about((0.0, 0.0, 1.0), 0.5 * _division_deg(ma)))
+    mb = mb.placed(rotation_about((0.0, 0.0, 1.0), 180.0 + 0.5 * _division_deg(mb)))
     za, zb = 0.5 * a.body_length, 0.5 * b.body_length
     ra, rb = 0.5 * a.body_outer_diameter, 0.5 * b.body_outer_diameter
     gap = 1e-3 * min(a.wall_thickness, b.wall_thickness)
@@ -76,6 +89,10 @@ def collide_cartridges(a: Optional[Cartridge] = None, b: Optional[Cartridge] = N
     rot = rotation_about((1.0, 0.0, 0.0), tilt)
     # b is centred on its body's middle, turned about x, then moved out along x.
     mesh_b = mb.placed(None, (0.0, 0.0, -zb)).placed(rot, (ra + rb + gap, 0.0, 0.0))
+    # The faceted surfaces lie inside the circles: close the extra clearance so that the
+    # meshes start `gap` apart along x.
+    shift = float(mesh_b.nodes[:, 0].min() - mesh_a.nodes[:, 0].max()) - gap
+    mesh_b = mesh_b.placed(None, (-shift, 0.0, 0.0))
     model = FemModel(
         bodies=[Body(mesh_a, name="a"), Body(mesh_b, velocity=(-v_rel, 0.0, 0.0), name="b")],
         material=mat, contact=ContactOptions(penalty_scale=penalty_scale, friction=friction,
@@ -87,14 +104,16 @@ def collide_cartridges(a: Optional[Cartridge] = None, b: Optional[Cartridge] = N
     dt = model.dt_step
     gap_time = gap / v_rel
     duration = gap_time + 4.0 * t_est
-    seen = {"on": False}
+    seen = {"on": False, "last": 0.0}
 
     def separated(m: FemModel) -> bool:
+        # Apart: no contact for a fifth of the expected duration while opening (a contact
+        # that chatters off for a few steps near the peak is not a separation).
         info = m.solver.contact_info() or {}
         if info.get("active_contacts", 0) > 0:
-            seen["on"] = True
+            seen["on"], seen["last"] = True, m.time
             return False
-        if not seen["on"]:
+        if not seen["on"] or m.time - seen["last"] < 0.2 * t_est:
             return False
         rel = m.body_velocity(1)[0] - m.body_velocity(0)[0]
         return rel > 0.0

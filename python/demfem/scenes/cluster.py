@@ -256,7 +256,8 @@ class CartridgeCluster:
             raise InvalidParameterError(f"invalid which = {which!r}: must be 'max' or 'typical'")
         check_range("window", window, 0.0, math.inf, lo_open=False)
         t = np.asarray(onsets)
-        if t.dtype.names is None or any(n not in t.dtype.names for n in ONSET_DTYPE.names):
+        names = t.dtype.names or ()
+        if not names or any(n not in names for n in (ONSET_DTYPE.names or ())):
             raise InvalidParameterError(
                 "invalid onsets: must be a structured array with the fields of "
                 "demfem.analysis.collisions.ONSET_DTYPE")
@@ -273,7 +274,7 @@ class CartridgeCluster:
             arr = np.array([[c[0][0], c[0][1], c[1][0], c[1][1], max(c[0][2], c[1][2])]
                             for c in cands], float)
             v2, a2, v3, a3, coord = np.median(arr, axis=0)
-        values = {"case": f"dem_{which}", "v2": float(v2), "v3": float(v3),
+        values: dict[str, Any] = {"case": f"dem_{which}", "v2": float(v2), "v3": float(v3),
                   "direction_2_deg": float(np.degrees(a2)),
                   "direction_3_deg": float(-60.0 + np.degrees(a3)),
                   "coordination": int(min(12, max(0, round(float(coord)))))}

@@ -150,7 +150,11 @@ def _simulate(cluster: CartridgeCluster, duration: float, n_snapshots: int, out:
     vtk_set = {round(t, 15) for t in vtk_times}
     vtk = out / "vtk"
     vtk.mkdir(parents=True, exist_ok=True)
-    energy, snaps_t, sig, press, frames = [], [], [], [], []
+    energy: list[Any] = []
+    snaps_t: list[Any] = []
+    sig: list[Any] = []
+    press: list[Any] = []
+    frames: list[Any] = []
     t_wall = _time.perf_counter()
     steps0 = int(model.solver.steps)
     try:

@@ -4,9 +4,9 @@
 //!
 //! **Normal.** Symmetric (two-pass): every surface node of every body is tested against the
 //! faces of the other bodies, so neither side is master only. A node behind a face's plane
-//! by d (0 < d ≤ half the height 3V/A of the element under the face; a new contact no deeper
-//! than the node and face closed in one step, so a node is never caught through a thin wall)
-//! whose projection falls on the face gets F = k_f d along the face's normal, k_f = s·K·A²/V (OpenRadioss TYPE7
+//! by d (0 < d ≤ half the height 3V/A of the element under the face, so a node outside a
+//! thin wall is never caught by the faces of its far side) whose projection falls on the
+//! face gets F = k_f d along the face's normal, k_f = s·K·A²/V (OpenRadioss TYPE7
 //! `Istf = 0`, s the penalty scale, [`ContactSettings::penalty_scale`]); the face's nodes
 //! take −F in the proportions of the projection's barycentric weights, so the pair's
 //! forces sum to zero (linear momentum is conserved to round-off). Against a rigid surface
@@ -55,6 +55,8 @@ use vec3::{add, cross, dot, norm, scale, sub, tangential};
 
 /// Surface nodes per parallel work item (fixed, so results do not depend on the threads).
 const NODE_CHUNK: usize = 512;
+/// Steps after a contact within which a node may return to a face at any depth.
+const RECENT_STEPS: u64 = 2;
 
 /// Settings of the contact model.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -179,6 +181,7 @@ pub struct ContactModel {
     stick: Vec<[f64; 3]>,
     stick_rigid: Vec<[f64; 3]>,
     last_face: Vec<u32>,
+    last_contact: Vec<u64>,
     x: Vec<[f64; 3]>,
     touched: Vec<usize>,
     f_prev: Vec<[f64; 3]>,
@@ -247,6 +250,7 @@ impl ContactModel {
             stick: vec![[0.0; 3]; ns],
             stick_rigid: Vec::new(),
             last_face: vec![u32::MAX; ns],
+            last_contact: vec![u64::MAX; ns],
             x: vec![[0.0; 3]; n],
             touched: surface.nodes.clone(),
             f_prev: vec![[0.0; 3]; n],
@@ -505,12 +509,15 @@ impl ContactModel {
                     for k in k0..k1 {
                         let i = this.surface.nodes[k];
                         let found = this.closest_face(k, 0.5).filter(|&(f, d, w)| {
-                            if this.last_face[k] != u32::MAX {
+                            // A node in contact within the last few steps may come back at
+                            // any depth the face takes (it lost the face for a step at an
+                            // edge); a fresh contact is only as deep as the node and the face
+                            // closed in one step, with a margin. Deeper is not a touch (and
+                            // a sudden deep spring would inject energy).
+                            let last = this.last_contact[k];
+                            if last != u64::MAX && this.steps - last <= RECENT_STEPS {
                                 return true;
                             }
-                            // A new contact can only be as deep as the node and the face
-                            // closed on each other in one step (with a margin); anything
-                            // deeper is a node seen through a wall, not a touch.
                             let face = &this.surface.faces[f];
                             let [a, b, cc] = face.nodes.map(|j| this.x[j]);
                             let nrm = cross(sub(b, a), sub(cc, a));
@@ -621,6 +628,7 @@ impl ContactModel {
                 let face = self.surface.faces[h.partner as usize];
                 self.stick[k] = h.tangential_force;
                 new_last[k] = h.partner;
+                self.last_contact[k] = self.steps;
                 for (j, &node) in face.nodes.iter().enumerate() {
                     force[node] = sub(force[node], scale(total, h.weights[j]));
                     let sl = self.surface.slot[node] as usize;
