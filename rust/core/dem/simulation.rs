@@ -156,10 +156,16 @@ pub struct Simulation {
     /// Step with the AVX2 build of the kernels (bitwise the same results; see `simd`).
     avx2: bool,
     /// Evaluate contacts in batches ([`Batch`]; bitwise the same results as one at a time).
+    ///
+    /// [`Batch`]: batch::Batch
     batched: bool,
     /// See [`PairCtx::pairs_hertz`] (set with the contact constants).
+    ///
+    /// [`PairCtx::pairs_hertz`]: pair::PairCtx::pairs_hertz
     pairs_hertz: bool,
     /// See [`PairCtx::pairs_uniform`] (set with the contact constants).
+    ///
+    /// [`PairCtx::pairs_uniform`]: pair::PairCtx::pairs_uniform
     pairs_uniform: Option<(u32, f64)>,
     pub(crate) record_every: u64,
     pub(crate) record_onsets: bool,

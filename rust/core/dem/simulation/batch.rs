@@ -19,6 +19,9 @@ mod avx2;
 pub(super) use avx2::advance4;
 
 /// Contacts handled together by the batched kernels ([`pair_chunk`], [`wall_chunk`]).
+///
+/// [`pair_chunk`]: super::pair::pair_chunk
+/// [`wall_chunk`]: super::wall::wall_chunk
 pub(super) const BATCH: usize = 64;
 
 /// Three components of up to [`BATCH`] vectors, each in its own array, so the elementwise
@@ -57,6 +60,9 @@ impl Lanes3 {
 /// pass is packed SIMD), where the one-contact-at-a-time kernel is one long dependency chain
 /// per contact. Every contact goes through the same IEEE operations in the same order as in
 /// [`pair_kernel`] and [`wall_kernel`], so the results are bitwise theirs.
+///
+/// [`pair_kernel`]: super::pair::pair_kernel
+/// [`wall_kernel`]: super::wall::wall_kernel
 pub(super) struct Batch {
     len: usize,
     /// Index of the contact in its block (pair or slot).
@@ -160,6 +166,8 @@ impl Batch {
     }
 
     /// Every lane's Hertz constants set to `konst` (see [`WallLists::plane_const`]).
+    ///
+    /// [`WallLists::plane_const`]: super::lists::WallLists::plane_const
     #[inline(always)]
     fn fill_constants(&mut self, konst: &ContactConst) {
         for k in 0..BATCH {
@@ -219,6 +227,8 @@ impl Batch {
 
 /// Overlap, unit normal and spin of the pairs of a batch from their centre distance: the
 /// operations of [`pair_kernel`] in its order.
+///
+/// [`pair_kernel`]: super::pair::pair_kernel
 #[inline(always)]
 fn pair_geometry<const E: u16>(b: &mut Batch, c: &PairCtx<'_>) {
     #[cfg(target_arch = "x86_64")]
@@ -249,6 +259,9 @@ fn pair_geometry<const E: u16>(b: &mut Batch, c: &PairCtx<'_>) {
 /// the Coulomb cap, n × f_t; the operations of [`pair_kernel`] and [`wall_kernel`] in their
 /// order (the scalar loop here, the AVX2 build in `avx2` with selects for branches).
 /// `all_hertz`: every lane's `hertz` mask is set (the AVX2 pass then skips the masks).
+///
+/// [`pair_kernel`]: super::pair::pair_kernel
+/// [`wall_kernel`]: super::wall::wall_kernel
 #[inline(always)]
 fn contact_forces<const E: u16>(b: &mut Batch, c: &PairCtx<'_>, all_hertz: bool) {
     #[cfg(target_arch = "x86_64")]

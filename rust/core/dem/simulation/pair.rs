@@ -12,6 +12,8 @@ use crate::dem::material::{ContactModel, PairLaw};
 use crate::geometry::Vec3;
 
 /// Read-only context of the pair kernel; the wall kernels share it (see [`WallCtx`]).
+///
+/// [`WallCtx`]: super::wall::WallCtx
 #[derive(Clone, Copy)]
 pub(super) struct PairCtx<'a> {
     /// The law constants the contacts index (`Simulation::contact_table`).
@@ -35,6 +37,8 @@ pub(super) struct PairCtx<'a> {
     pub(super) batched: bool,
     /// Every pair follows the Hertz law ([`LawKind::Hertz`]), so with AVX2 the batched pair
     /// kernel copies the constants without testing the law of each.
+    ///
+    /// [`LawKind::Hertz`]: super::law::LawKind::Hertz
     pub(super) pairs_hertz: bool,
     /// Every pair indexes the same Hertz or Hertz–Reissner entry of `table` and every
     /// particle has the same radius (m): (entry, radius). The batched pair kernel then writes

@@ -17,6 +17,8 @@ use crate::geometry::Vec3;
 
 impl Simulation {
     /// Whether the next step ends with a recorded [`Frame`] (which needs the step's records).
+    ///
+    /// [`Frame`]: crate::dem::Frame
     pub(super) fn frame_due_next(&self) -> bool {
         self.record_every > 0 && (self.steps + 1) % self.record_every == 0
     }

@@ -22,13 +22,19 @@ pub(super) struct WallCtx<'a> {
 }
 
 /// One block's part of the [`WallLists`].
+///
+/// [`WallLists`]: super::lists::WallLists
 #[derive(Clone, Copy)]
 pub(super) struct BlockWalls<'a> {
     pub(super) planes: &'a [(u32, u32)],
     pub(super) rest: &'a [(u32, u32)],
     /// [`WallLists::plane_const`].
+    ///
+    /// [`WallLists::plane_const`]: super::lists::WallLists::plane_const
     pub(super) plane_const: Option<u32>,
     /// [`WallLists::plane_reissner`].
+    ///
+    /// [`WallLists::plane_reissner`]: super::lists::WallLists::plane_reissner
     pub(super) plane_reissner: bool,
 }
 
