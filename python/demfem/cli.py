@@ -67,7 +67,7 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     for r in sorted(data["runs"], key=lambda r: (r["tilt_deg"], r["E_Pa"])):
         print(f"  tilt {r['tilt_deg']:4.0f} deg  E {r['E_Pa']:9.2e} Pa  FEM {r['max_force_N']:8.3f} N"
               f"  Hertz-Reissner {r['hertz_reissner_N']:8.3f} N"
-              f"  ({100 * (r['hertz_reissner_N'] / r['max_force_N'] - 1):+.0f} %)")
+              f"  (Hertz-Reissner / FEM = {r['hertz_reissner_N'] / r['max_force_N']:.2f})")
     csv, png = write_calibration(args.out, table, curves)
     print(f"\nwrote {csv}\nwrote {png}")
     return 0

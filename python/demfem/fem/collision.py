@@ -42,6 +42,8 @@ class CollisionResult:
     dt: float
     energy_balance_error: float
     result: FemResult
+    peak_sigma1_inner: float = float("nan")
+    peak_sigma1_outer: float = float("nan")
 
 
 def _division_deg(mesh) -> float:
@@ -56,7 +58,8 @@ def collide_cartridges(a: Optional[Cartridge] = None, b: Optional[Cartridge] = N
                        material: Optional[Material] = None, v_rel: float = 0.2,
                        tilt_deg: float = 90.0, layers: int = 2, elements: str = "tet",
                        target_size: Optional[float] = None, friction: float = 0.2,
-                       penalty_scale: float = 1.0, progress: bool = False) -> CollisionResult:
+                       penalty_scale: float = 1.0, progress: bool = False,
+                       stress_samples: int = 0) -> CollisionResult:
     """Collide two cartridges and measure the contact.
 
     Cartridge ``a`` stands upright (axis z), centred on the middle of its cylindrical body
@@ -65,6 +68,8 @@ def collide_cartridges(a: Optional[Cartridge] = None, b: Optional[Cartridge] = N
     contact along the bodies), 90 crossed tubes (a point contact, the paper's Fig. 2b
     configuration). ``b`` closes on ``a`` at ``v_rel`` (m/s) along x; no gravity, no belt.
     ``material`` defaults to ``a``'s glass. ``layers``: elements through the wall.
+    ``stress_samples``: how many times over the expected contact to sample σ1 on ``a``'s
+    surfaces (0: not at all).
     """
     a = a or Cartridge()
     b = b or a
@@ -105,8 +110,29 @@ def collide_cartridges(a: Optional[Cartridge] = None, b: Optional[Cartridge] = N
     gap_time = gap / v_rel
     duration = gap_time + 4.0 * t_est
     seen = {"on": False, "last": 0.0}
+    # a's surface nodes on its cylindrical body (away from the ends), inner and outer.
+    r_a = np.hypot(mesh_a.nodes[:, 0], mesh_a.nodes[:, 1])
+    body_a = np.abs(mesh_a.nodes[:, 2]) < 0.45 * a.body_length
+    r_body = r_a[body_a]
+    inner = np.nonzero(body_a & (r_a < r_body.min() * (1 + 1e-9)))[0]
+    outer = np.nonzero(body_a & (r_a > r_body.max() * (1 - 1e-9)))[0]
+    peaks = {"inner": 0.0, "outer": 0.0, "next": 0.0}
+    every = t_est / stress_samples if stress_samples > 0 else math.inf
+
+    def sample_stress(m: FemModel) -> None:
+        if m.time < peaks["next"]:
+            return
+        peaks["next"] = m.time + every
+        from demfem import _core
+        ns = np.asarray(m.solver.nodal_stresses())[: mesh_a.n_nodes]
+        p, _ = _core.fem_stress_invariants(np.ascontiguousarray(ns[np.concatenate([inner, outer])]))
+        s1 = np.asarray(p)[:, 0]
+        peaks["inner"] = max(peaks["inner"], float(s1[: inner.size].max(initial=0.0)))
+        peaks["outer"] = max(peaks["outer"], float(s1[inner.size:].max(initial=0.0)))
 
     def separated(m: FemModel) -> bool:
+        if stress_samples > 0 and seen["on"]:
+            sample_stress(m)
         # Apart: no contact for a fifth of the expected duration while opening (a contact
         # that chatters off for a few steps near the peak is not a separation).
         info = m.solver.contact_info() or {}
@@ -135,4 +161,6 @@ def collide_cartridges(a: Optional[Cartridge] = None, b: Optional[Cartridge] = N
         max_force=float(smooth.max()), raw_max_force=float(fn.max()), contact_duration=t_c,
         restitution=float(rel_after / v_rel), time=res.time, force=fn, wall_time=wall,
         n_elements=model.mesh.n_elements, dt=dt, energy_balance_error=res.energy_balance_error(),
-        result=res)
+        result=res,
+        peak_sigma1_inner=peaks["inner"] if stress_samples > 0 else float("nan"),
+        peak_sigma1_outer=peaks["outer"] if stress_samples > 0 else float("nan"))
