@@ -195,9 +195,12 @@ def fem_tet_mesh(
     n_layers: int,
     target_size: float,
     min_dihedral_deg: float = 5.0,
+    max_elements: int = 5_000_000,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int64], dict[str, float]]:
     """Revolved linear-tet mesh of the axisymmetric body (stations z, radii in m):
-    (nodes (N,3) m, tets (E,4), quality dict). Slivers below min_dihedral_deg are refused."""
+    (nodes (N,3) m, tets (E,4), quality dict). Slivers below min_dihedral_deg are refused;
+    so is, before meshing, a target_size giving more than max_elements elements, and
+    n_theta < 3 or n_layers < 1 (InvalidParameterError naming the argument)."""
 
 def fem_ball_mesh(radius: float, n: int) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]:
     """Tet mesh of a ball of ``radius`` m (2n cells across): (nodes (N,3) m, tets (E,4))."""

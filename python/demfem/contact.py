@@ -346,10 +346,22 @@ def rayleigh_time_step(radius: float, E: float, nu: float, density: float) -> fl
     nu = _check_nu("nu", nu)
     rho = check_positive("density", density)
     G = E / (2.0 * (1.0 + nu))
-    return math.pi * R * math.sqrt(rho / G) / (0.1631 * nu + 0.8766)
+    dt = math.pi * R * math.sqrt(rho / G) / (0.1631 * nu + 0.8766) if G > 0 else math.inf
+    if not (G > 0 and math.isfinite(dt) and dt > 0):
+        # a subnormal E underflows G to 0 (rho / G divided by zero)
+        raise InvalidParameterError(
+            f"invalid E = {E!r}: must be large enough that G = E/(2(1+nu)) > 0 and the step "
+            "pi R sqrt(rho/G)/(0.1631 nu + 0.8766) is finite and > 0")
+    return dt
 
 
 # ---------------------------------------------------------------------------- restitution
+#: Largest Tsuji ζ that :func:`tsuji_restitution` integrates (as the core's
+#: ``MAX_TSUJI_ZETA``); beyond it the overdamped limit e = 1.25/ζ² (clamped) or 0 is returned
+#: (the core's fixed-step integration returned -1 at ζ = 1e20).
+MAX_TSUJI_ZETA = 1e3
+
+
 def _tsuji_rhs(zeta: float, clamp: bool):
     def rhs(_t: float, y: np.ndarray) -> list[float]:
         x, v = max(y[0], 0.0), y[1]
@@ -382,6 +394,10 @@ def tsuji_restitution(zeta: float, clamp: bool = False) -> float:
     Integrated here with an adaptive Runge–Kutta method (DOP853, rtol 1e-12).
     """
     zeta = check_range("zeta", zeta, 0.0, math.inf, lo_open=False)
+    if zeta > MAX_TSUJI_ZETA:
+        # overdamped limit (as the core): clamped, e = X_m^{5/4}/zeta with
+        # X_m = (5/(4 zeta))^{4/5}, i.e. 1.25/zeta^2; unclamped, the bodies stay together
+        return 1.25 / (zeta * zeta) if clamp else 0.0
     rhs = _tsuji_rhs(zeta, clamp)
 
     events = [_overlap_exit]

@@ -241,3 +241,102 @@ def test_a_vtk_series_replaces_the_old_frames(tmp_path):
     assert len(list(tmp_path.glob("table_*.vtp"))) == 3
     listed = (tmp_path / "table.pvd").read_text().count("<DataSet")
     assert listed == 3
+
+
+# ---- issue 30: no hang, no unbounded memory, no silent sliver or double prescription ----------
+
+CART_Z, CART_RI, CART_RO = np.array([0.0, 3e-3]), np.array([4.7e-3, 4.7e-3]), np.array([5.8e-3, 5.8e-3])
+
+
+def test_centres_at_1e308_are_refused_naming_positions_not_searched_forever():
+    t = time.monotonic()
+    with pytest.raises(InvalidParameterError, match="invalid positions.*neighbour cells"):
+        dem.DemSimulation(np.array([[-1e308, 0.0, R], [1e308, 0.0, R]]), np.array([R, R]),
+                          [GLASS], [], ["gravity"])
+    # a finite but absurd span (1e9 diameters) is refused too, naming the allowed extent
+    with pytest.raises(InvalidParameterError, match=r"positions.*<= 1\.6e5 m"):
+        dem.DemSimulation(np.array([[0.0, 0.0, R], [0.0, 1.6e7, R]]), np.array([R, R]),
+                          [GLASS], [], ["gravity"])
+    assert time.monotonic() - t < 5.0
+    # a wide but sane scene is accepted
+    dem.DemSimulation(np.array([[0.0, 0.0, R], [100.0, 0.0, R]]), np.array([R, R]), [GLASS], [],
+                      ["gravity"]).step(5)
+
+
+def test_a_tiny_target_size_is_refused_before_meshing():
+    t = time.monotonic()
+    with pytest.raises(InvalidParameterError, match="invalid target_size.*max_elements"):
+        _core.fem_tet_mesh(CART_Z, CART_RI, CART_RO, 24, 2, 1e-9)
+    assert time.monotonic() - t < 2.0
+    nodes, tets, q = _core.fem_tet_mesh(CART_Z, CART_RI, CART_RO, 24, 2, 1e-3)
+    with pytest.raises(InvalidParameterError, match="target_size"):
+        _core.fem_tet_mesh(CART_Z, CART_RI, CART_RO, 24, 2, 1e-3, max_elements=len(tets) - 1)
+    with pytest.raises(InvalidParameterError, match="invalid max_elements = 0"):
+        _core.fem_tet_mesh(CART_Z, CART_RI, CART_RO, 24, 2, 1e-3, max_elements=0)
+
+
+@pytest.mark.parametrize("n_theta, n_layers, field", [
+    (12, -1, "invalid n_layers = -1"), (-3, 1, "invalid n_theta = -3"),
+    (2, 1, "invalid n_theta = 2"), (12, 0, "invalid n_layers = 0"),
+])
+def test_negative_or_too_small_mesh_counts_name_the_field(n_theta, n_layers, field):
+    with pytest.raises(InvalidParameterError, match=field):
+        _core.fem_tet_mesh(CART_Z, CART_RI, CART_RO, n_theta, n_layers, 1e-3)
+
+
+def test_a_sliver_element_is_refused_by_the_explicit_solver_naming_it():
+    nodes = np.array([[0.0, 0, 0], [1e-3, 0, 0], [0, 1e-3, 0], [0.5e-3, 0.5e-3, 1e-12]])
+    with pytest.raises(InvalidParameterError, match="invalid mesh = element 0 is a sliver"):
+        _core.FemTetSolver(nodes, np.array([[0, 1, 2, 3]]), 63e9, 0.22, 2230.0)
+
+
+def test_two_prescriptions_of_one_dof_are_refused_naming_it():
+    nodes, tets, _ = _core.fem_tet_mesh(CART_Z, CART_RI, CART_RO, 12, 1, 1.5e-3)
+    s = _core.FemTetSolver(nodes, tets, 63e9, 0.22, 2230.0)
+    s.set_prescribed(np.array([[0, 2], [0, 2]]), np.array([0.0, 0.0]))  # the same twice: fine
+    with pytest.raises(InvalidParameterError, match="invalid prescribed = node 0 component 2"):
+        s.set_prescribed(np.array([[0, 2], [1, 0], [0, 2]]), np.array([0.0, 0.0, 1e-4]))
+
+
+def test_tiny_tilted_wall_is_refused_naming_the_range():
+    with pytest.raises(InvalidParameterError,
+                       match=r"invalid tilted_wall_length = 0\.02.*must be in \[0\.02\d*, "):
+        AccumulationTable(tilted_wall_length=0.02)
+
+
+def test_huge_tsuji_zeta_gives_the_overdamped_restitution():
+    from demfem import contact
+
+    # the core's fixed-step integration returned -1 at zeta = 1e20: beyond 1e3 the
+    # overdamped limit 1.25/zeta^2 (clamped) or 0 is returned, by both implementations
+    assert _core.tsuji_restitution(1e20, True) == pytest.approx(1.25e-40, rel=1e-12)
+    assert contact.tsuji_restitution(1e20, True) == pytest.approx(1.25e-40, rel=1e-12)
+    assert _core.tsuji_restitution(1e20, False) == 0.0
+    e = _core.tsuji_restitution(1e3, True)
+    assert e == pytest.approx(contact.tsuji_restitution(1e3, True), rel=1e-6)
+    assert e == pytest.approx(1.25e-6, rel=1e-4)  # the limit joins the integration
+    with pytest.raises(InvalidParameterError, match="invalid zeta"):
+        _core.tsuji_restitution(-1.0, True)
+
+
+def test_extreme_reissner_stiffness_ratio_gives_a_finite_force():
+    from demfem import contact
+
+    d = np.array([1e-3, 2e-3])
+    for k_h, k_r in [(1.0, 1e-300), (1e-300, 1e300), (1e300, 1e-300), (1e10, 1e6)]:
+        f, kt = _core.normal_force(d, "hertz_reissner", k_h=k_h, k_r=k_r, k=1.0)
+        assert np.isfinite(f).all() and np.isfinite(kt).all() and (f > 0).all()
+        assert f == pytest.approx(contact.normal_force(d, "hertz_reissner", k_h=k_h, k_r=k_r),
+                                  rel=1e-9)
+        assert f[1] > f[0]
+    with pytest.raises(InvalidParameterError, match="k_R"):
+        _core.normal_force(d, "hertz_reissner", k_h=1.0, k_r=0.0, k=1.0)
+
+
+def test_subnormal_modulus_in_rayleigh_step_is_refused_naming_E():
+    from demfem import contact
+
+    with pytest.raises(InvalidParameterError, match="invalid E = 5e-324"):
+        contact.rayleigh_time_step(1.0, 5e-324, 0.0, 1.0)
+    with pytest.raises(InvalidParameterError, match="invalid E = 5e-324"):
+        _core.rayleigh_time_step(1.0, 5e-324, 0.0, 1.0)

@@ -394,39 +394,26 @@ def test_tet_mesh_inputs_give_a_valid_mesh_or_are_refused(n_theta, layers, size,
 # to be removed, once the code outside these tests is fixed)
 # --------------------------------------------------------------------------------------------
 
-@pytest.mark.xfail(strict=True, raises=AssertionError,
-                   reason="tsuji_restitution(zeta, clamp=True) returns -1 for huge zeta")
 def test_known_clamped_tsuji_at_huge_zeta_is_a_restitution():
     e = _core.tsuji_restitution(1e20, True)
     assert 0.0 <= e <= 1.0
 
 
-@pytest.mark.xfail(strict=True, raises=ValueError,
-                   reason="AccumulationTable(tilted_wall_length=0.02).build() raises a bare "
-                          "ValueError (no hexagonal site) instead of a DemfemError")
 def test_known_tiny_tilted_wall_is_refused_with_a_demfem_error():
     assert outcome(lambda: AccumulationTable(tilted_wall_length=0.02).build()) is REFUSED
 
 
-@pytest.mark.xfail(strict=True, raises=OverflowError,
-                   reason="fem_tet_mesh with a negative n_layers/n_theta raises pyo3's "
-                          "OverflowError instead of InvalidParameterError")
 def test_known_negative_mesh_counts_are_refused_with_a_demfem_error():
     z = np.array([0.0, 3 * MM])
     assert outcome(lambda: _core.fem_tet_mesh(z, np.array([4.7, 4.7]) * MM, np.array([5.8, 5.8]) * MM,
                                               12, -1, 1 * MM)) is REFUSED
 
 
-@pytest.mark.xfail(strict=True, raises=ZeroDivisionError,
-                   reason="contact.rayleigh_time_step with a subnormal E divides by zero "
-                          "(the core returns a step)")
 def test_known_subnormal_modulus_in_rayleigh_step():
     a = outcome(lambda: contact.rayleigh_time_step(1.0, 5e-324, 0.0, 1.0))
     assert a is REFUSED or math.isfinite(a)
 
 
-@pytest.mark.xfail(strict=True, raises=AssertionError,
-                   reason="normal_force(..., 'hertz_reissner', k_r=1e-300) returns NaN")
 def test_known_tiny_reissner_stiffness_gives_a_finite_force():
     f, kt = _core.normal_force(np.array([1e-3]), "hertz_reissner", k_h=1.0, k_r=1e-300, k=1.0)
     assert finite(f, kt)

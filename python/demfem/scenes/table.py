@@ -68,6 +68,7 @@ the caption and text; all are chosen on the start positions):
 """
 from __future__ import annotations
 
+import copy
 import dataclasses
 import json
 import math
@@ -516,6 +517,19 @@ class AccumulationTable:
                     f"invalid rolling_resistance = {self.rolling_resistance!r} with particle = "
                     f"{self.particle!r}: full shapes roll by their shape, the rolling-"
                     "resistance model is for spheres; use 0")
+        n_hex = len(self._hexagonal_sites())
+        if n_hex < 3:
+            # the start tags the triangular section's centre and both vertices: three sites
+            l_max = self.width / sin_t
+            l_min = self._shortest_tilted_wall(3, l_max)
+            allowed = (f"[{l_min:.4g}, {l_max:.4g}) m" if l_min is not None
+                       else "none at this width, angle and sphere size")
+            raise InvalidParameterError(
+                f"invalid tilted_wall_length = {self.tilted_wall_length!r}: the triangular "
+                f"section leaves room for {n_hex} spheres, at least 3 are needed (its centre "
+                f"and both vertices are tagged); must be in {allowed} with width = "
+                f"{self.width:g} m, tilted_wall_angle_deg = {self.tilted_wall_angle_deg:g} "
+                f"and a packing pitch of {self.pitch:.4g} m")
         n_min, n_max = self._sphere_count_range()
         if not n_min <= self.n_spheres <= n_max:
             raise InvalidParameterError(
@@ -599,6 +613,21 @@ class AccumulationTable:
         return tuple(names)
 
     # ---- start positions -------------------------------------------------------------------
+
+    def _shortest_tilted_wall(self, n_sites: int, l_max: float) -> float | None:
+        """Shortest tilted-wall length (m, to 1 %) below ``l_max`` whose triangular section
+        holds ``n_sites`` hexagonal sites, other fields as they are; None if there is none
+        (used for the validation message only)."""
+        probe = copy.copy(self)
+        length = max(self.pitch / 20.0, self.tilted_wall_length)
+        for _ in range(5000):
+            if not length < l_max:
+                break
+            object.__setattr__(probe, "tilted_wall_length", length)
+            if len(probe._hexagonal_sites()) >= n_sites:
+                return length
+            length *= 1.01
+        return None
 
     def _hexagonal_sites(self) -> np.ndarray:
         """(k, 2) centres of the hexagonal packing of the constricted section, in columns

@@ -285,6 +285,52 @@ pub(crate) fn array_n3<'py>(py: Python<'py>, v: &[Vec3]) -> PyResult<Bound<'py, 
     Ok(flat3(v).into_pyarray(py).reshape([v.len(), 3])?.into_any())
 }
 
+/// Most neighbour-grid cells (of one particle diameter) the particle centres may span along
+/// one axis: beyond it the scene is refused rather than searched (centres at ±1e308 m made
+/// the grid build spin at 100 % CPU).
+pub(crate) const MAX_GRID_CELLS_PER_AXIS: f64 = 1e7;
+
+/// Refuse particle centres whose span along an axis exceeds [`MAX_GRID_CELLS_PER_AXIS`]
+/// particle diameters (2 r_max), or overflows. Non-finite centres and bad radii are left to
+/// the scene's own validation, which names them.
+fn check_grid_extent(position: &[Vec3], radius: &[f64]) -> PyResult<()> {
+    let r_max = radius
+        .iter()
+        .copied()
+        .filter(|r| r.is_finite() && *r > 0.0)
+        .fold(0.0f64, f64::max);
+    if r_max <= 0.0 || position.len() < 2 {
+        return Ok(());
+    }
+    let mut lo = Vec3::splat(f64::INFINITY);
+    let mut hi = Vec3::splat(f64::NEG_INFINITY);
+    for p in position.iter().filter(|p| p.is_finite()) {
+        lo = lo.min(*p);
+        hi = hi.max(*p);
+    }
+    let cell = 2.0 * r_max;
+    let allowed = MAX_GRID_CELLS_PER_AXIS * cell;
+    let (lo, hi) = (lo.to_array(), hi.to_array());
+    for (k, axis) in ["x", "y", "z"].iter().enumerate() {
+        let span = hi[k] - lo[k];
+        // an empty set of finite centres leaves span = -inf: nothing to check
+        if span > allowed || span.is_nan() {
+            return Err(invalid(
+                "positions",
+                &format!(
+                    "centres spanning {span:e} m along {axis} (from {:e} to {:e} m)",
+                    lo[k], hi[k]
+                ),
+                &format!(
+                    "an extent of at most {MAX_GRID_CELLS_PER_AXIS:e} neighbour cells of one \
+                     particle diameter (2 r_max = {cell:e} m) per axis, i.e. <= {allowed:e} m"
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// A DEM simulation of spheres and walls (see `demfem._core.pyi` for the full signature).
 #[pyclass(module = "demfem._core")]
 pub struct DemSimulation {
@@ -357,6 +403,7 @@ impl DemSimulation {
                 format!("{} entries for {n} particles", radius.len()),
             ));
         }
+        check_grid_extent(&position, &radius)?;
         let mut p = ParticleInit::at_rest(position, radius);
         if let Some(v) = velocities {
             let v = float2(&crate::as_float_array(v, "velocities")?, "velocities")?;

@@ -106,21 +106,40 @@ fn profile(
 /// Revolved linear-tetrahedron mesh of an axisymmetric body (stations z, radii r_in,
 /// r_out in m). Returns (nodes (N,3) m, tets (E,4) int64, quality dict).
 #[pyfunction]
-#[pyo3(signature = (z, r_in, r_out, n_theta, n_layers, target_size, min_dihedral_deg=5.0))]
+#[pyo3(signature = (
+    z, r_in, r_out, n_theta, n_layers, target_size, min_dihedral_deg=5.0,
+    max_elements=demfem::fem::mesh::MAX_TET_ELEMENTS as i64
+))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 fn fem_tet_mesh<'py>(
     py: Python<'py>,
     z: PyReadonlyArray1<'py, f64>,
     r_in: PyReadonlyArray1<'py, f64>,
     r_out: PyReadonlyArray1<'py, f64>,
-    n_theta: usize,
-    n_layers: usize,
+    n_theta: i64,
+    n_layers: i64,
     target_size: f64,
     min_dihedral_deg: f64,
+    max_elements: i64,
 ) -> PyResult<(Nodes<'py>, Bound<'py, PyArray2<i64>>, Bound<'py, PyDict>)> {
+    // signed, so a negative count is refused by name instead of pyo3's OverflowError
+    let whole = |field: &str, v: i64, lo: i64| -> PyResult<usize> {
+        if v < lo {
+            return Err(crate::dem::invalid(
+                field,
+                &v.to_string(),
+                &format!("a whole number >= {lo}"),
+            ));
+        }
+        usize::try_from(v)
+            .map_err(|_| crate::dem::invalid(field, &v.to_string(), "a whole number that fits"))
+    };
+    let n_theta = whole("n_theta", n_theta, 3)?;
+    let n_layers = whole("n_layers", n_layers, 1)?;
+    let max_elements = whole("max_elements", max_elements, 1)?;
     let p = profile(z, r_in, r_out)?;
     let rm = py
-        .detach(|| p.tet_mesh(n_theta, n_layers, target_size))
+        .detach(|| p.tet_mesh_limited(n_theta, n_layers, target_size, max_elements))
         .map_err(PyDemfemError::from)?;
     let q = rm
         .mesh

@@ -304,7 +304,7 @@ fn parse_clamp(clamp: bool) -> ForceClamp {
 #[pyfunction]
 #[pyo3(signature = (zeta, clamp=false))]
 fn tsuji_restitution(py: Python<'_>, zeta: f64, clamp: bool) -> PyResult<f64> {
-    demfem::error::check_non_negative("zeta", zeta).map_err(PyDemfemError::from)?;
+    contact::check_tsuji_zeta(zeta).map_err(PyDemfemError::from)?;
     Ok(py.detach(|| contact::tsuji_restitution(zeta, parse_clamp(clamp))))
 }
 

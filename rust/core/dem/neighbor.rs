@@ -42,8 +42,18 @@ impl CellGrid {
         if n_alive < 2 {
             return;
         }
-        let mut cell = 2.0 * r_max + skin;
-        let extent = hi - lo;
+        // Coordinates spanning more than f64::MAX (centres near ±1e308) overflow hi - lo to
+        // infinity, and an infinite extent kept the cell-growing loop below spinning forever:
+        // such a grid is measured in half coordinates (h = 0.5), which cannot overflow for
+        // finite positions. h = 1 otherwise, so the usual grid is unchanged bit for bit.
+        let h = if (hi - lo).is_finite() { 1.0 } else { 0.5 };
+        let extent = hi * h - lo * h;
+        let lo_h = lo * h;
+        let mut cell = (2.0 * r_max + skin) * h;
+        if !(cell.is_finite() && cell > 0.0) {
+            // no usable reach (zero radii and skin, or overflow): one cell per axis
+            cell = f64::MAX;
+        }
         // keep the grid at most ~4 cells per particle so a far-away stray particle cannot blow
         // up memory; cells larger than needed only cost extra distance checks
         // capped before the cast so a stray particle far away cannot overflow the count
@@ -51,15 +61,23 @@ impl CellGrid {
             let k = |e: f64| (e / c).floor().min(1e12) as usize + 1;
             [k(extent.x), k(extent.y), k(extent.z)]
         };
+        let budget = 4.0 * n_alive as f64 + 64.0;
         let mut d = dims(cell);
-        while (d[0] as f64) * (d[1] as f64) * (d[2] as f64) > 4.0 * n_alive as f64 + 64.0 {
+        // bounded: the extent is finite, so the count falls to 1 per axis once the cell
+        // exceeds it (at most ~1800 growths from the smallest positive cell to f64::MAX)
+        while (d[0] as f64) * (d[1] as f64) * (d[2] as f64) > budget {
+            if cell >= f64::MAX / 1.5 {
+                cell = f64::MAX;
+                d = [1, 1, 1];
+                break;
+            }
             cell *= 1.5;
             d = dims(cell);
         }
         let n_cells = d[0] * d[1] * d[2];
         let inv = 1.0 / cell;
         let cell_coord = |p: Vec3| -> [usize; 3] {
-            let q = (p - lo) * inv;
+            let q = (p * h - lo_h) * inv;
             [
                 (q.x as usize).min(d[0] - 1),
                 (q.y as usize).min(d[1] - 1),

@@ -28,7 +28,7 @@ use crate::fem::contact::{ContactEnergy, ContactModel};
 use crate::fem::assembly::{lumped_mass, precompute_tets, NodeAdjacency};
 use crate::fem::element::Tet4;
 use crate::fem::material::LinearElastic;
-use crate::fem::mesh::TetMesh;
+use crate::fem::mesh::{tet_quality, TetMesh};
 use crate::fem::stable_step::{
     certified_eigenvalue_bound, critical_step_from_eigenvalue, mass_scaling_factors,
     EigenvalueBound, StepBound,
@@ -402,6 +402,48 @@ pub struct ExplicitSolver {
     dt_limit_without_contact: f64,
 }
 
+/// Smallest dihedral angle, degrees, of an element the explicit solver accepts: a sliver
+/// below it has a critical step orders of magnitude below its neighbours' (1e-16 s for a
+/// flattened tet) and would make the whole run take forever.
+pub const MIN_ELEMENT_DIHEDRAL_DEG: f64 = 0.5;
+
+/// Smallest element volume the explicit solver accepts, as a fraction of the mean.
+pub const MIN_ELEMENT_VOLUME_FRACTION: f64 = 1e-12;
+
+/// Refuse sliver elements (a dihedral angle below [`MIN_ELEMENT_DIHEDRAL_DEG`]) and
+/// near-degenerate ones (volume below [`MIN_ELEMENT_VOLUME_FRACTION`] × the mean), naming
+/// the element. Inverted elements and bad indices are left to [`TetMesh::validate`].
+fn check_element_shapes(mesh: &TetMesh) -> Result<()> {
+    mesh.validate()?;
+    let mean = mesh.volume() / mesh.tets.len() as f64;
+    for (e, t) in mesh.tets.iter().enumerate() {
+        let q = tet_quality(t.map(|i| mesh.nodes[i]));
+        if !(q.min_dihedral_deg >= MIN_ELEMENT_DIHEDRAL_DEG) {
+            return Err(DemfemError::InvalidParameter {
+                field: "mesh".into(),
+                value: format!(
+                    "element {e} is a sliver: min dihedral angle {:.3e}°",
+                    q.min_dihedral_deg
+                ),
+                allowed: format!(
+                    "elements with every dihedral angle >= {MIN_ELEMENT_DIHEDRAL_DEG}° \
+                     (a sliver's stable step is far below its neighbours')"
+                ),
+            });
+        }
+        if !(q.volume >= MIN_ELEMENT_VOLUME_FRACTION * mean) {
+            return Err(DemfemError::InvalidParameter {
+                field: "mesh".into(),
+                value: format!("element {e} has volume {:e} m³ (mean {mean:e} m³)", q.volume),
+                allowed: format!(
+                    "elements of volume >= {MIN_ELEMENT_VOLUME_FRACTION:e} × the mean"
+                ),
+            });
+        }
+    }
+    Ok(())
+}
+
 impl ExplicitSolver {
     /// Build the solver: precompute elements, lumped masses (with optional mass scaling)
     /// and the time step. Fails on bad input or a `config.dt` above the critical-step bound.
@@ -410,6 +452,7 @@ impl ExplicitSolver {
         check_open("safety_factor", config.safety_factor, 0.0, 1.0 + 1e-12)?;
         check_non_negative("rayleigh_alpha", config.rayleigh_alpha)?;
         check_non_negative("rayleigh_beta", config.rayleigh_beta)?;
+        check_element_shapes(mesh)?;
         let (lambda, mu) = config.material.lame();
         let rho = config.material.density;
         let kernel = TetForceKernel::new(mesh, lambda, mu)?;
@@ -525,6 +568,23 @@ impl ExplicitSolver {
             };
             if !v.is_finite() {
                 return Err(DemfemError::invalid("prescribed value", v, "finite"));
+            }
+            let (k0, v0) = (kind[p.node][p.component], value[p.node][p.component]);
+            if k0 != 0 && (k0 != k || v0 != v) {
+                let name = |k: u8| if k == 1 { "displacement" } else { "velocity" };
+                return Err(DemfemError::InvalidParameter {
+                    field: "prescribed".into(),
+                    value: format!(
+                        "node {} component {} prescribed twice: {} {v0:e} and {} {v:e}",
+                        p.node,
+                        p.component,
+                        name(k0),
+                        name(k)
+                    ),
+                    allowed: "at most one value per node and component (repeating the same \
+                              prescription is allowed)"
+                        .into(),
+                });
             }
             kind[p.node][p.component] = k;
             value[p.node][p.component] = v;

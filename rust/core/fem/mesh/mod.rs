@@ -14,7 +14,7 @@ mod revolve;
 
 pub use compose::{ball_tet_mesh, place, union};
 pub use quality::{tet_quality, MeshQuality, TetQuality};
-pub use revolve::{box_tet_mesh, AxisymmetricProfile, RevolvedTetMesh};
+pub use revolve::{box_tet_mesh, AxisymmetricProfile, RevolvedTetMesh, MAX_TET_ELEMENTS};
 
 use crate::error::{DemfemError, Result};
 

@@ -4,6 +4,10 @@
 use super::{signed_volume, TetMesh, TriMesh};
 use crate::error::{check_positive, DemfemError, Result};
 
+/// Default largest element count of [`AxisymmetricProfile::tet_mesh`]: beyond it a mesh is
+/// refused before meshing (5e6 linear tets is already several GB with the solver's arrays).
+pub const MAX_TET_ELEMENTS: usize = 5_000_000;
+
 /// Axisymmetric description of a hollow body of revolution about the z axis: at height
 /// `z[k]` the material is the annulus `r_in[k] <= r <= r_out[k]`; radii vary linearly
 /// between stations. Both ends are open. All lengths in metres.
@@ -125,11 +129,38 @@ impl AxisymmetricProfile {
     /// `n_layers` through the wall, axial divisions from `target_size` (m). Each hexahedral
     /// cell is split into six tets (Kuhn subdivision), giving a conforming mesh.
     /// Fails for `n_theta < 3`, `n_layers < 1`, a non-positive size, or inverted cells.
+    ///
+    /// Meshes estimated above [`MAX_TET_ELEMENTS`] elements are refused before any memory
+    /// is allocated (see [`AxisymmetricProfile::tet_mesh_limited`]).
     pub fn tet_mesh(
         &self,
         n_theta: usize,
         n_layers: usize,
         target_size: f64,
+    ) -> Result<RevolvedTetMesh> {
+        self.tet_mesh_limited(n_theta, n_layers, target_size, MAX_TET_ELEMENTS)
+    }
+
+    /// Number of elements [`AxisymmetricProfile::tet_mesh`] would make (6 per hexahedral
+    /// cell), computed without meshing, as a float so that no size overflows.
+    pub fn tet_mesh_element_count(&self, n_theta: usize, n_layers: usize, target_size: f64) -> f64 {
+        let axial: f64 = self
+            .z
+            .windows(2)
+            .map(|w| ((w[1] - w[0]) / target_size).ceil().max(1.0))
+            .sum();
+        axial * n_layers as f64 * n_theta as f64 * 6.0
+    }
+
+    /// [`AxisymmetricProfile::tet_mesh`] refusing, before meshing, a mesh of more than
+    /// `max_elements` elements (the error names `target_size`, the estimated count and the
+    /// limit), so a tiny target size fails at once instead of exhausting memory.
+    pub fn tet_mesh_limited(
+        &self,
+        n_theta: usize,
+        n_layers: usize,
+        target_size: f64,
+        max_elements: usize,
     ) -> Result<RevolvedTetMesh> {
         self.validate()?;
         check_positive("target_size", target_size)?;
@@ -138,6 +169,22 @@ impl AxisymmetricProfile {
         }
         if n_layers < 1 {
             return Err(DemfemError::invalid("n_layers", n_layers as f64, ">= 1"));
+        }
+        let estimate = self.tet_mesh_element_count(n_theta, n_layers, target_size);
+        if !(estimate <= max_elements as f64) {
+            let length = self.z[self.z.len() - 1] - self.z[0];
+            return Err(DemfemError::InvalidParameter {
+                field: "target_size".into(),
+                value: format!(
+                    "{target_size:e} m (with n_theta = {n_theta}, n_layers = {n_layers}: \
+                     about {estimate:.3e} elements)"
+                ),
+                allowed: format!(
+                    "large enough for at most max_elements = {max_elements} elements \
+                     (over the {length:e} m length, >= about {:.3e} m here)",
+                    target_size * estimate / max_elements as f64
+                ),
+            });
         }
         let stations = self.axial_stations(target_size);
         let nj = n_layers + 1;
