@@ -55,3 +55,31 @@ def test_kill_9_after_a_checkpoint_then_resume_gives_the_uninterrupted_numbers(t
     subprocess.run([sys.executable, "-c", RUN, str(killed)], check=True, timeout=600)
     _complete(killed)
     assert _table_numbers(killed) == _table_numbers(ref)
+
+
+ASSESS = ("import sys; from demfem.assess import assess; "
+          "assess(out=sys.argv[1], duration=0.12, checkpoint_every=0.3, log=lambda s: None)")
+
+
+def _risk_numbers(folder: Path) -> dict:
+    r = json.loads((folder / "risk.json").read_text())
+    return {k: v for k, v in r.items() if "wall" not in k and k != "settings"}
+
+
+def test_kill_9_of_assess_during_the_dem_then_resume_gives_the_uninterrupted_risk(tmp_path):
+    ref, killed = tmp_path / "ref", tmp_path / "killed"
+    subprocess.run([sys.executable, "-c", ASSESS, str(ref)], check=True, timeout=600)
+    proc = subprocess.Popen([sys.executable, "-c", ASSESS, str(killed)])
+    meta = killed / "table.ck.json"
+    t0 = time.time()
+    while not meta.exists() and proc.poll() is None and time.time() - t0 < 300:
+        time.sleep(0.05)
+    assert proc.poll() is None, "the assessment ended before its first DEM checkpoint"
+    time.sleep(0.2)
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait(timeout=30)
+    assert proc.returncode == -signal.SIGKILL and not (killed / "report.html").exists()
+    _complete(killed)
+    subprocess.run([sys.executable, "-c", ASSESS, str(killed)], check=True, timeout=600)
+    _complete(killed)
+    assert _risk_numbers(killed) == _risk_numbers(ref)
