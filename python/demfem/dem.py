@@ -39,7 +39,7 @@ __all__ = [
     "CONTACT_MODELS",
 ]
 
-CONTACT_MODELS = ("hertz_mindlin", "hertz_reissner_mindlin", "linear")
+CONTACT_MODELS = ("hertz_mindlin", "hertz_reissner_mindlin", "linear", "fem_line")
 
 Vector = Sequence[float]
 
@@ -183,13 +183,17 @@ def from_scene(
     threads: int = 1,
     record_every: int = 0,
     record_onsets: bool = True,
+    linear_stiffness: Optional[tuple[float, float]] = None,
 ) -> DemSimulation:
     """Build the engine from an engine-neutral scene description
     (:class:`demfem.scenes.table.SceneDescription`).
 
     ``model``: ``"hertz_reissner_mindlin"`` (default: the calibrated equivalent sphere of the
     paper, Hertz in series with the Reissner stiffness of the cartridge wall, Mindlin
-    tangential spring), ``"hertz_mindlin"`` or ``"linear"``. The Reissner stiffness uses
+    tangential spring), ``"hertz_mindlin"``, ``"linear"`` (with ``linear_stiffness`` =
+    (k_n, k_t) in N/m) or ``"fem_line"``: the linear law calibrated on the explicit FEM of two
+    cartridges meeting side by side (:func:`demfem.fem.line_law.line_contact_stiffness`), for
+    upright cartridges whose impacts are line contacts. The Reissner stiffness uses
     ``shell_thickness`` and ``shell_radius`` (m; default: the default cartridge's wall
     thickness and body mid-surface radius); walls do not bend (infinite shell stiffness).
     ``dt`` (s) defaults to ``dt_safety`` times the stable limit; a larger one is refused.
@@ -220,6 +224,15 @@ def from_scene(
         t = c.wall_thickness if shell_thickness is None else shell_thickness
         r = c.body_mid_radius if shell_radius is None else shell_radius
         k_r = reissner_stiffness(pm["young_modulus"], pm["poisson_ratio"], t, r)
+    engine_model = model
+    if model == "fem_line":
+        from demfem.fem.line_law import line_contact_stiffness
+
+        linear_stiffness = line_contact_stiffness(pm["young_modulus"], pm["poisson_ratio"])
+        engine_model = "linear"
+    elif model == "linear" and linear_stiffness is None:
+        raise InvalidParameterError(
+            "invalid linear_stiffness = None: model 'linear' needs (k_n, k_t) in N/m")
     names = [scene.particle_material] + [n for n in mats if n != scene.particle_material]
     materials = [material(mats[n]["young_modulus"], mats[n]["poisson_ratio"], mats[n]["density"],
                           friction=mats[n]["friction"], restitution=mats[n]["restitution"],
@@ -244,7 +257,8 @@ def from_scene(
         materials, walls, list(scene.effects),
         tags=np.asarray(scene.tags, dtype=np.int64),
         gravity=(float(scene.gravity[0]), float(scene.gravity[1]), float(scene.gravity[2])),
-        model=model, dt=dt, dt_safety=dt_safety, expected_max_speed=expected_max_speed,
+        model=engine_model, linear_stiffness=linear_stiffness, dt=dt, dt_safety=dt_safety,
+        expected_max_speed=expected_max_speed,
         threads=threads, record_every=record_every, record_onsets=record_onsets,
         removal_plane=removal_plane,
     )

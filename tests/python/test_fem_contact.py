@@ -74,3 +74,29 @@ def test_bad_input_names_the_field():
         collide_cartridges(v_rel=-1.0)
     r = rotation_about((1, 0, 0), 90.0)
     assert np.allclose(r @ [0, 0, 1], [0, -1, 0])
+
+
+def test_fem_calibrated_line_law_reproduces_the_stored_fem_and_runs_in_the_dem():
+    from demfem import dem
+    from demfem.fem import fig3
+    from demfem.fem.line_law import line_contact_stiffness
+    from demfem.scenes import AccumulationTable
+
+    data = fig3.load_stored()
+    row = next(r for r in data["runs"] if r["tilt_deg"] == 0.0 and r["E_Pa"] == 1e10)
+    m_star = 0.5 * Cartridge().mass
+    k_n, k_t = line_contact_stiffness(1e10, 0.22)
+    # the linear spring's peak force at the FEM's speed is the FEM's peak force
+    v = data["v_rel_m_per_s"]
+    assert v * np.sqrt(k_n * m_star) == pytest.approx(row["max_force_N"], rel=1e-9)
+    assert k_t / k_n == pytest.approx(2 * (1 - 0.22) / (2 - 0.22))
+    k2, _ = line_contact_stiffness(2e10, 0.22)
+    assert 1.5 < k2 / k_n < 2.5  # k ∝ E between the stored moduli
+    scene = AccumulationTable(n_spheres=252).build()
+    sim = dem.from_scene(scene, model="fem_line")
+    dem.run(sim, 0.002)
+    assert np.isfinite(sim.positions()).all()
+    with pytest.raises(InvalidParameterError, match="linear_stiffness"):
+        dem.from_scene(scene, model="linear")
+    with pytest.raises(InvalidParameterError, match="young_modulus"):
+        line_contact_stiffness(-1.0, 0.2)
