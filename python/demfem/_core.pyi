@@ -195,11 +195,11 @@ def fem_tet_mesh(
     n_layers: int,
     target_size: float,
     min_dihedral_deg: float = 5.0,
-    max_elements: int = 5_000_000,
+    max_elements: int = ...,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int64], dict[str, float]]:
     """Revolved linear-tet mesh of the axisymmetric body (stations z, radii in m):
     (nodes (N,3) m, tets (E,4), quality dict). Slivers below min_dihedral_deg are refused;
-    so is, before meshing, a target_size giving more than max_elements elements, and
+    so is, before meshing, a target_size giving more than max_elements (default 5e6) elements, and
     n_theta < 3 or n_layers < 1 (InvalidParameterError naming the argument)."""
 
 def fem_ball_mesh(radius: float, n: int) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]:
