@@ -173,7 +173,7 @@ fn elastic_ball_on_a_rigid_plane_follows_hertz_impact() {
     let ef = out.peak / f_h - 1.0;
     let et = out.duration / t_h - 1.0;
     println!("ball on plane: peak {:.4} N (Hertz {f_h:.4}, {ef:+.3}), duration {:.4e} s (Hertz {t_h:.4e}, {et:+.3})", out.peak, out.duration);
-    // 8 cells per radius: linear tets are stiff, the filtered peak is ~11 % above Hertz.
+    // 8 cells per radius: linear tets are stiff, the filtered peak is ~10 % above Hertz.
     assert!(ef.abs() < 0.16, "peak force off Hertz by {ef}");
     assert!(et.abs() < 0.10, "contact duration off Hertz by {et}");
     assert!(out.dt_ok && out.reduced);
@@ -191,7 +191,7 @@ fn two_equal_balls_head_on_follow_hertz_and_conserve_momentum() {
     let ef = out.peak / f_h - 1.0;
     let et = out.duration / t_h - 1.0;
     println!("two balls: peak {:.4} N (Hertz {f_h:.4}, {ef:+.3}), duration {:.4e} s (Hertz {t_h:.4e}, {et:+.3}), momentum {:e}", out.peak, out.duration, out.momentum_error);
-    // 8 cells per radius: linear tets are stiff, the filtered peak is ~12 % above Hertz.
+    // 8 cells per radius: linear tets are stiff, the filtered peak is ~9 % above Hertz.
     assert!(ef.abs() < 0.16, "peak force off Hertz by {ef}");
     assert!(et.abs() < 0.10, "contact duration off Hertz by {et}");
     assert!(out.momentum_error < 1e-12, "momentum drift {}", out.momentum_error);

@@ -227,8 +227,16 @@ impl ContactModel {
         let nu = material.poisson_ratio;
         let bulk = material.youngs_modulus / (3.0 * (1.0 - 2.0 * nu));
         let surface = Surface::new(mesh, body_of_node, bulk, settings.penalty_scale)?;
-        let n_bodies = body_of_node.iter().map(|&b| b as usize + 1).max().unwrap_or(0);
-        let n_regions = region_of_node.iter().map(|&r| r as usize + 1).max().unwrap_or(1);
+        let n_bodies = body_of_node
+            .iter()
+            .map(|&b| b as usize + 1)
+            .max()
+            .unwrap_or(0);
+        let n_regions = region_of_node
+            .iter()
+            .map(|&r| r as usize + 1)
+            .max()
+            .unwrap_or(1);
         if n_bodies > 4096 || n_regions > 64 {
             return Err(DemfemError::InvalidParameter {
                 field: "body_of_node / region_of_node".into(),
@@ -236,7 +244,9 @@ impl ContactModel {
                 allowed: "at most 4096 bodies and 64 regions".into(),
             });
         }
-        let margin = settings.margin.unwrap_or(0.5 * surface.mean_edge.max(1e-12));
+        let margin = settings
+            .margin
+            .unwrap_or(0.5 * surface.mean_edge.max(1e-12));
         let ns = surface.nodes.len();
         Ok(Self {
             settings,
@@ -372,7 +382,11 @@ impl ContactModel {
         }
         let mut face_term: f64 = 0.0;
         for f in &sf.faces {
-            let mf = f.nodes.iter().map(|&i| mass[i]).fold(f64::INFINITY, f64::min);
+            let mf = f
+                .nodes
+                .iter()
+                .map(|&i| mass[i])
+                .fold(f64::INFINITY, f64::min);
             let ms = (0..self.n_bodies)
                 .filter(|&b| b != f.body as usize)
                 .map(|b| min_mass[b])
@@ -450,6 +464,23 @@ impl ContactModel {
         }
     }
 
+    /// Unit normal of `face` now and the velocity (m/s) of its point with barycentric
+    /// weights `w`.
+    fn face_normal_and_velocity(
+        &self,
+        face: &SurfaceFace,
+        w: [f64; 3],
+        v: &[[f64; 3]],
+    ) -> ([f64; 3], [f64; 3]) {
+        let [a, b, c] = face.nodes.map(|j| self.x[j]);
+        let nrm = cross(sub(b, a), sub(c, a));
+        let vf = add(
+            add(scale(v[face.nodes[0]], w[0]), scale(v[face.nodes[1]], w[1])),
+            scale(v[face.nodes[2]], w[2]),
+        );
+        (scale(nrm, 1.0 / norm(nrm)), vf)
+    }
+
     /// The face the surface node `k` is behind (face index, penetration, weights).
     fn closest_face(&self, k: usize, depth_fraction: f64) -> Option<(usize, f64, [f64; 3])> {
         let p = self.x[self.surface.nodes[k]];
@@ -487,7 +518,14 @@ impl ContactModel {
     /// Contact and spring forces (N, added into `force`, one per node) at displacement `u`
     /// (m) and velocity `v` (m/s) at time `t` (s), for a step `dt` (s). A contact that runs
     /// away or springs that exceed the certified allowance are kept for [`Self::take_failure`].
-    pub fn compute(&mut self, u: &[[f64; 3]], v: &[[f64; 3]], t: f64, dt: f64, force: &mut [[f64; 3]]) {
+    pub fn compute(
+        &mut self,
+        u: &[[f64; 3]],
+        v: &[[f64; 3]],
+        t: f64,
+        dt: f64,
+        force: &mut [[f64; 3]],
+    ) {
         self.update_positions(u);
         if self.broad.needs_rebuild(&self.surface, u) {
             self.broad.rebuild(&self.surface, &self.x, u);
@@ -508,58 +546,48 @@ impl ContactModel {
                     let mut out = Vec::new();
                     for k in k0..k1 {
                         let i = this.surface.nodes[k];
-                        let found = this.closest_face(k, 0.5).filter(|&(f, d, w)| {
+                        if let Some((f, d, w)) = this.closest_face(k, 0.5) {
+                            let face = &this.surface.faces[f];
+                            let (n, vf) = this.face_normal_and_velocity(face, w, v);
+                            let vrel = sub(v[i], vf);
                             // A node in contact within the last few steps may come back at
                             // any depth the face takes (it lost the face for a step at an
                             // edge); a fresh contact is only as deep as the node and the face
                             // closed in one step, with a margin. Deeper is not a touch (and
                             // a sudden deep spring would inject energy).
                             let last = this.last_contact[k];
-                            if last != u64::MAX && this.steps - last <= RECENT_STEPS {
-                                return true;
+                            let recent = last != u64::MAX && this.steps - last <= RECENT_STEPS;
+                            let entry = 2.0 * (-dot(vrel, n)).max(0.0) * dt + 1e-6 * face.depth;
+                            if recent || d <= entry {
+                                let h =
+                                    friction_update(stick[k], n, vrel, d, face.stiffness, mu, dt);
+                                out.push(Hit {
+                                    slave: k as u32,
+                                    partner: f as u32,
+                                    rigid: false,
+                                    weights: w,
+                                    normal_force: h.0,
+                                    tangential_force: h.1,
+                                    stiffness: face.stiffness,
+                                    penetration: d,
+                                    elastic: h.2,
+                                    dissipated: h.3,
+                                    rigid_work: 0.0,
+                                });
                             }
-                            let face = &this.surface.faces[f];
-                            let [a, b, cc] = face.nodes.map(|j| this.x[j]);
-                            let nrm = cross(sub(b, a), sub(cc, a));
-                            let n = scale(nrm, 1.0 / norm(nrm));
-                            let vf = add(
-                                add(scale(v[face.nodes[0]], w[0]), scale(v[face.nodes[1]], w[1])),
-                                scale(v[face.nodes[2]], w[2]),
-                            );
-                            let closing = -dot(sub(v[i], vf), n);
-                            d <= 2.0 * closing.max(0.0) * dt + 1e-6 * face.depth
-                        });
-                        if let Some((f, d, w)) = found {
-                            let face = &this.surface.faces[f];
-                            let [a, b, cc] = face.nodes.map(|j| this.x[j]);
-                            let nrm = cross(sub(b, a), sub(cc, a));
-                            let n = scale(nrm, 1.0 / norm(nrm));
-                            let vf = add(
-                                add(scale(v[face.nodes[0]], w[0]), scale(v[face.nodes[1]], w[1])),
-                                scale(v[face.nodes[2]], w[2]),
-                            );
-                            let vrel = sub(v[i], vf);
-                            let h = friction_update(stick[k], n, vrel, d, face.stiffness, mu, dt);
-                            out.push(Hit {
-                                slave: k as u32,
-                                partner: f as u32,
-                                rigid: false,
-                                weights: w,
-                                normal_force: h.0,
-                                tangential_force: h.1,
-                                stiffness: face.stiffness,
-                                penetration: d,
-                                elastic: h.2,
-                                dissipated: h.3,
-                                rigid_work: 0.0,
-                            });
                         }
                         for (r, s) in this.rigid.iter().enumerate() {
                             if let Some((d, n, vs)) = s.probe(this.x[i], t) {
                                 let kn = this.surface.node_stiffness[k];
                                 let vrel = sub(v[i], vs);
                                 let h = friction_update(
-                                    stick_rigid[k * nr + r], n, vrel, d, kn, s.friction, dt,
+                                    stick_rigid[k * nr + r],
+                                    n,
+                                    vrel,
+                                    d,
+                                    kn,
+                                    s.friction,
+                                    dt,
                                 );
                                 // Power the moving surface puts into the body: F·v_s.
                                 let work = dot(add(h.0, h.1), vs) * dt;
@@ -665,7 +693,12 @@ impl ContactModel {
                             .unwrap_or(0);
                         f.nodes[j]
                     });
-                    (other, body, -1.0, face.map_or(0, |n| self.region[n] as usize))
+                    (
+                        other,
+                        body,
+                        -1.0,
+                        face.map_or(0, |n| self.region[n] as usize),
+                    )
                 };
                 let c = pair_index(a, b, parties) * self.n_regions + region;
                 sums[c][0] = add(sums[c][0], scale(h.normal_force, sign));
@@ -707,7 +740,10 @@ impl ContactModel {
             }
         }
         if check {
-            let g = self.touched.iter().fold(0.0f64, |m, &i| m.max(self.gershgorin[i]));
+            let g = self
+                .touched
+                .iter()
+                .fold(0.0f64, |m, &i| m.max(self.gershgorin[i]));
             self.max_gershgorin = self.max_gershgorin.max(g);
             if g > self.allowance * (1.0 + 1e-12) && self.failure.is_none() {
                 self.failure = Some(DemfemError::Numerical(format!(
@@ -792,5 +828,10 @@ fn friction_update(
         (trial, 0.0)
     };
     let ft_mag = norm(ft);
-    (normal, ft, 0.5 * k * d * d + 0.5 * ft_mag * ft_mag / k, dissipated)
+    (
+        normal,
+        ft,
+        0.5 * k * d * d + 0.5 * ft_mag * ft_mag / k,
+        dissipated,
+    )
 }
