@@ -84,8 +84,16 @@ impl BroadPhase {
         let h = if h > 0.0 && h.is_finite() { h } else { 1.0 };
         let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
         for f in 0..nf {
-            let c0 = [cell_of(lo[f][0], h), cell_of(lo[f][1], h), cell_of(lo[f][2], h)];
-            let c1 = [cell_of(hi[f][0], h), cell_of(hi[f][1], h), cell_of(hi[f][2], h)];
+            let c0 = [
+                cell_of(lo[f][0], h),
+                cell_of(lo[f][1], h),
+                cell_of(lo[f][2], h),
+            ];
+            let c1 = [
+                cell_of(hi[f][0], h),
+                cell_of(hi[f][1], h),
+                cell_of(hi[f][2], h),
+            ];
             // h is at least the box's extent, so a box spans at most two cells per axis.
             for i in c0[0]..=c1[0].min(c0[0] + 1) {
                 for j in c0[1]..=c1[1].min(c0[1] + 1) {

@@ -48,6 +48,9 @@ impl NoTensionSpring {
             return ([0.0; 3], 0.0);
         }
         let c = self.rest_length - l;
-        (scale(r, self.stiffness * c / l), 0.5 * self.stiffness * c * c)
+        (
+            scale(r, self.stiffness * c / l),
+            0.5 * self.stiffness * c * c,
+        )
     }
 }

@@ -118,7 +118,11 @@ impl Surface {
             }
             let area = 0.5 * norm(nrm);
             let [a, b, c] = [x(nodes[0]), x(nodes[1]), x(nodes[2])];
-            let vol = (dot(sub(x(t[1]), x(t[0])), cross(sub(x(t[2]), x(t[0])), sub(x(t[3]), x(t[0])))) / 6.0).abs();
+            let vol = (dot(
+                sub(x(t[1]), x(t[0])),
+                cross(sub(x(t[2]), x(t[0])), sub(x(t[3]), x(t[0]))),
+            ) / 6.0)
+                .abs();
             if !(area > 0.0) || !(vol > 0.0) {
                 return Err(DemfemError::Numerical(format!(
                     "element {e}: degenerate boundary face (area {area:e} m², volume {vol:e} m³)"
