@@ -12,7 +12,8 @@ from demfem.fem.mesh import (ShellMesh, TetMesh, ball_tet_mesh, cartridge_shell_
                              cartridge_tet_mesh, estimated_tet_count, rotation_about)
 from demfem.fem.model import (Body, ContactOptions, FemModel, GhostSprings, RigidCylinder,
                               RigidPlane, RigidSphere)
-from demfem.fem.result import ENERGY_COLUMNS, FemResult, Snapshot, moving_average, write_pvd
+from demfem.fem.result import ENERGY_COLUMNS, FemResult, Snapshot, moving_average
+from demfem.io.vtk import write_pvd
 
 __all__ = [
     "Body", "CollisionResult", "ContactOptions", "ENERGY_COLUMNS", "FemModel", "FemResult",

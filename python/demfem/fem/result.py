@@ -12,7 +12,6 @@ from typing import TYPE_CHECKING, Sequence, Union
 import numpy as np
 
 from demfem.errors import InvalidParameterError
-from demfem.io.atomic import write_text_atomic
 
 if TYPE_CHECKING:  # pragma: no cover
     from demfem.fem.model import FemModel
@@ -121,11 +120,3 @@ def moving_average(x: np.ndarray, w: int) -> np.ndarray:
     lo = np.maximum(i - w // 2, 0)
     hi = np.minimum(i + w // 2 + 1, n)
     return (c[hi] - c[lo]) / (hi - lo)
-
-
-def write_pvd(path: Union[str, Path], frames: Sequence[tuple[float, str]]) -> Path:
-    """Write a ParaView collection (``.pvd``) listing ``(time_s, file)`` frames, atomically."""
-    rows = "\n".join(f'    <DataSet timestep="{t:.9g}" part="0" file="{f}"/>' for t, f in frames)
-    text = ('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n  <Collection>\n'
-            f"{rows}\n  </Collection>\n</VTKFile>\n")
-    return write_text_atomic(path, text)

@@ -57,15 +57,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping, Optional
 
-try:
-    import tomllib
-except ModuleNotFoundError:  # Python < 3.11
-    import tomli as tomllib  # type: ignore[no-redef]
-
 import numpy as np
 
 from demfem.cartridge import Cartridge
-from demfem.errors import DemfemIOError, InvalidParameterError, check_range
+from demfem.errors import InvalidParameterError, check_range
 from demfem.io.atomic import write_text_atomic
 from demfem.materials import PAPER_GLASS, Material
 
@@ -455,15 +450,10 @@ class CartridgeCluster:
     @classmethod
     def from_toml(cls, path: str | Path) -> "CartridgeCluster":
         """Load a cluster scene file (TOML; see the module text)."""
+        from demfem.io.toml_file import read_toml
+
         path = Path(path)
-        try:
-            text = path.read_text(encoding="utf-8")
-        except OSError as exc:
-            raise DemfemIOError(f"i/o error on {path}: {exc.strerror or exc}") from None
-        try:
-            values = tomllib.loads(text)
-        except tomllib.TOMLDecodeError as exc:
-            raise InvalidParameterError(f"invalid TOML in {path}: {exc}") from None
+        values = read_toml(path)
         return cls.from_dict(values, source=str(path))
 
     def toml_text(self) -> str:

@@ -77,11 +77,6 @@ from enum import IntEnum
 from pathlib import Path
 from typing import Any, Mapping
 
-try:
-    import tomllib
-except ModuleNotFoundError:  # Python < 3.11: the same parser, published as tomli
-    import tomli as tomllib  # type: ignore[no-redef]
-
 import numpy as np
 from scipy.spatial import cKDTree
 
@@ -843,15 +838,10 @@ class AccumulationTable:
     def from_toml(cls, path: str | Path) -> "AccumulationTable":
         """Load a table from a TOML file of ``key = value`` lines named as the fields (SI
         units); missing keys take their defaults, unknown keys are errors."""
+        from demfem.io.toml_file import read_toml
+
         path = Path(path)
-        try:
-            text = path.read_text(encoding="utf-8")
-        except OSError as exc:
-            raise DemfemIOError(f"i/o error on {path}: {exc.strerror or exc}") from None
-        try:
-            values = tomllib.loads(text)
-        except tomllib.TOMLDecodeError as exc:
-            raise InvalidParameterError(f"invalid TOML in {path}: {exc}") from None
+        values = read_toml(path)
         for key, value in values.items():
             if isinstance(value, dict):
                 raise InvalidParameterError(

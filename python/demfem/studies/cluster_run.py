@@ -128,7 +128,8 @@ def run_cluster(cluster: CartridgeCluster, duration: float = 3e-3,
 def _simulate(cluster: CartridgeCluster, duration: float, n_snapshots: int, out: Path,
               progress: bool, log: Log, stress_interval: float) -> dict:
     from demfem import _core
-    from demfem.fem.result import FemResult, write_pvd
+    from demfem.fem.result import FemResult
+    from demfem.io.vtk import write_pvd
 
     t_build = _time.perf_counter()
     parts = cluster.parts()
