@@ -1,6 +1,6 @@
-"""kill -9 at any moment loses nothing already written: a `demfem run` killed after its
-first checkpoint leaves only complete files, and the same command started again resumes
-and ends with the numbers of an uninterrupted run (issue 30)."""
+"""kill -9 at any moment loses nothing already written: a `demfem run` or `demfem assess`
+killed after its first DEM checkpoint leaves only complete files, and the same call started
+again resumes and ends with the numbers of an uninterrupted run (issue 30)."""
 import json
 import os
 import signal
@@ -14,11 +14,18 @@ import numpy as np
 RUN = ("import sys; from demfem.pipeline import run_pipeline; "
        "run_pipeline(out=sys.argv[1], duration=0.12, sample_interval=0.02, threads=1, "
        "checkpoint_every=0.3, log=lambda s: None)")
+ASSESS = ("import sys; from demfem.assess import assess; "
+          "assess(out=sys.argv[1], duration=0.12, checkpoint_every=0.3, log=lambda s: None)")
 
 
 def _table_numbers(folder: Path) -> dict:
     s = json.loads((folder / "summary.json").read_text())
     return {k: v for k, v in s["table"].items() if not k.startswith("wall") and "wall" not in k}
+
+
+def _risk_numbers(folder: Path) -> dict:
+    r = json.loads((folder / "risk.json").read_text())
+    return {k: v for k, v in r.items() if "wall" not in k and k != "settings"}
 
 
 def _complete(folder: Path) -> None:
@@ -37,10 +44,13 @@ def _complete(folder: Path) -> None:
             assert p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", p
 
 
-def test_kill_9_after_a_checkpoint_then_resume_gives_the_uninterrupted_numbers(tmp_path):
+def _kill_after_checkpoint_and_resume(code: str, tmp_path: Path, final: str) -> tuple[Path, Path]:
+    """Run ``code`` to the end in ``ref``; in ``killed``, SIGKILL it just after its first
+    DEM checkpoint (checking that ``final`` is not there yet and every file is whole), then
+    run it again to the end. Returns (ref, killed)."""
     ref, killed = tmp_path / "ref", tmp_path / "killed"
-    subprocess.run([sys.executable, "-c", RUN, str(ref)], check=True, timeout=600)
-    proc = subprocess.Popen([sys.executable, "-c", RUN, str(killed)])
+    subprocess.run([sys.executable, "-c", code, str(ref)], check=True, timeout=600)
+    proc = subprocess.Popen([sys.executable, "-c", code, str(killed)])
     meta = killed / "table.ck.json"
     t0 = time.time()
     while not meta.exists() and proc.poll() is None and time.time() - t0 < 300:
@@ -50,36 +60,18 @@ def test_kill_9_after_a_checkpoint_then_resume_gives_the_uninterrupted_numbers(t
     os.kill(proc.pid, signal.SIGKILL)
     proc.wait(timeout=30)
     assert proc.returncode == -signal.SIGKILL
-    assert meta.exists() and not (killed / "summary.json").exists()
+    assert meta.exists() and not (killed / final).exists()
     _complete(killed)
-    subprocess.run([sys.executable, "-c", RUN, str(killed)], check=True, timeout=600)
+    subprocess.run([sys.executable, "-c", code, str(killed)], check=True, timeout=600)
     _complete(killed)
+    return ref, killed
+
+
+def test_kill_9_after_a_checkpoint_then_resume_gives_the_uninterrupted_numbers(tmp_path):
+    ref, killed = _kill_after_checkpoint_and_resume(RUN, tmp_path, "summary.json")
     assert _table_numbers(killed) == _table_numbers(ref)
 
 
-ASSESS = ("import sys; from demfem.assess import assess; "
-          "assess(out=sys.argv[1], duration=0.12, checkpoint_every=0.3, log=lambda s: None)")
-
-
-def _risk_numbers(folder: Path) -> dict:
-    r = json.loads((folder / "risk.json").read_text())
-    return {k: v for k, v in r.items() if "wall" not in k and k != "settings"}
-
-
 def test_kill_9_of_assess_during_the_dem_then_resume_gives_the_uninterrupted_risk(tmp_path):
-    ref, killed = tmp_path / "ref", tmp_path / "killed"
-    subprocess.run([sys.executable, "-c", ASSESS, str(ref)], check=True, timeout=600)
-    proc = subprocess.Popen([sys.executable, "-c", ASSESS, str(killed)])
-    meta = killed / "table.ck.json"
-    t0 = time.time()
-    while not meta.exists() and proc.poll() is None and time.time() - t0 < 300:
-        time.sleep(0.05)
-    assert proc.poll() is None, "the assessment ended before its first DEM checkpoint"
-    time.sleep(0.2)
-    os.kill(proc.pid, signal.SIGKILL)
-    proc.wait(timeout=30)
-    assert proc.returncode == -signal.SIGKILL and not (killed / "report.html").exists()
-    _complete(killed)
-    subprocess.run([sys.executable, "-c", ASSESS, str(killed)], check=True, timeout=600)
-    _complete(killed)
+    ref, killed = _kill_after_checkpoint_and_resume(ASSESS, tmp_path, "report.html")
     assert _risk_numbers(killed) == _risk_numbers(ref)
