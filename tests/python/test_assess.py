@@ -7,6 +7,7 @@ Weibull and slow-crack-growth formulas equal demfem.risk's functions.
 import csv
 import json
 import math
+import os
 import re
 
 import numpy as np
@@ -225,6 +226,55 @@ def test_outputs_and_report(small_job):
     assert st["window_s"] == [0.06, 0.12]
     assert st["events_first_half"] + st["events_second_half"] == doc["summary"][
         "n_events_window"]
+
+
+def _chromium():
+    import shutil
+    for name in ("chromium", "chromium-browser", "google-chrome"):
+        path = shutil.which(name)
+        if path:
+            return path
+    if os.environ.get("DEMFEM_REQUIRE_CHROMIUM"):
+        pytest.fail("headless Chromium is required here (DEMFEM_REQUIRE_CHROMIUM) but not found")
+    pytest.skip("no headless Chromium (Debian package chromium)")
+
+
+def test_report_renders_in_headless_chromium(small_job, tmp_path):
+    """Chromium loads report.html and every figure decodes: a copy of the report gets a probe
+    script (the report itself has none) that writes into the title how many images have a
+    non-zero natural size, whether the summary table has rows, and the page height; the
+    screenshot is not blank."""
+    import subprocess
+
+    out, _, _ = small_job
+    page = (out / "report.html").read_text()
+    probe = ("<script>window.addEventListener('load', () => {"
+             "const im = [...document.images];"
+             "const ok = im.filter(i => i.complete && i.naturalWidth > 0).length;"
+             "const rows = document.querySelectorAll('table.summary tr').length;"
+             "document.title = `probe images=${im.length} decoded=${ok} summary_rows=${rows} "
+             "height=${document.body.scrollHeight}`;});</script>")
+    probed = tmp_path / "probed.html"
+    probed.write_text(page.replace("</body>", probe + "</body>"))
+    exe = _chromium()
+    flags = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
+             "--allow-file-access-from-files", "--virtual-time-budget=10000"]
+    dom = subprocess.run([exe, *flags, "--dump-dom", probed.as_uri()], capture_output=True,
+                         text=True, timeout=120).stdout
+    m = re.search(r"<title>probe images=(\d+) decoded=(\d+) summary_rows=(\d+) "
+                  r"height=(\d+)</title>", dom)
+    assert m, dom[:500]
+    images, decoded, rows, height = map(int, m.groups())
+    assert images == len(FIGURES) and decoded == images
+    assert rows >= 5 and height > 2000
+    shot = tmp_path / "report.png"
+    subprocess.run([exe, *flags, f"--screenshot={shot}", "--window-size=1200,2400",
+                    (out / "report.html").as_uri()], capture_output=True, timeout=120)
+    import matplotlib.image as mpimg
+
+    px = mpimg.imread(shot)
+    assert px.shape[0] == 2400 and px.shape[1] == 1200
+    assert float(px[..., :3].std()) > 0.02  # text and figures, not a blank page
 
 
 @pytest.mark.parametrize("kwargs, field", [

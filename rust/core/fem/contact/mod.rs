@@ -147,6 +147,8 @@ struct Hit {
     tangential_force: [f64; 3],
     stiffness: f64,
     penetration: f64,
+    /// Depth subtracted from `penetration` in the force (see `ContactModel::offset`), m.
+    offset: f64,
     elastic: f64,
     dissipated: f64,
     rigid_work: f64,
@@ -182,6 +184,16 @@ pub struct ContactModel {
     stick_rigid: Vec<[f64; 3]>,
     last_face: Vec<u32>,
     last_contact: Vec<u64>,
+    // Per surface node: the face of its last contact with a body, the depth the force used
+    // there (penetration less offset), and the offset. A node that moves onto another face
+    // of a faceted surface can be deeper behind the new face's plane than it was behind the
+    // old one; taking the new depth at once would store energy the contact never received
+    // as work (a kick). The offset keeps the force's depth continuous across the switch, so
+    // the contact stays conservative; it only shrinks (as the node comes out), and it is
+    // zero except after such a switch.
+    contact_face: Vec<u32>,
+    last_depth: Vec<f64>,
+    offset: Vec<f64>,
     x: Vec<[f64; 3]>,
     touched: Vec<usize>,
     f_prev: Vec<[f64; 3]>,
@@ -261,6 +273,9 @@ impl ContactModel {
             stick_rigid: Vec::new(),
             last_face: vec![u32::MAX; ns],
             last_contact: vec![u64::MAX; ns],
+            contact_face: vec![u32::MAX; ns],
+            last_depth: vec![0.0; ns],
+            offset: vec![0.0; ns],
             x: vec![[0.0; 3]; n],
             touched: surface.nodes.clone(),
             f_prev: vec![[0.0; 3]; n],
@@ -557,10 +572,29 @@ impl ContactModel {
                             // a sudden deep spring would inject energy).
                             let last = this.last_contact[k];
                             let recent = last != u64::MAX && this.steps - last <= RECENT_STEPS;
-                            let entry = 2.0 * (-dot(vrel, n)).max(0.0) * dt + 1e-6 * face.depth;
-                            if recent || d <= entry {
-                                let h =
-                                    friction_update(stick[k], n, vrel, d, face.stiffness, mu, dt);
+                            let closing = 2.0 * (-dot(vrel, n)).max(0.0) * dt;
+                            let margin = 1e-6 * face.depth;
+                            let offset = if !recent {
+                                (d <= closing + margin).then_some(0.0)
+                            } else if this.contact_face[k] == f as u32 {
+                                Some(this.offset[k].min(d))
+                            } else {
+                                // Onto another face: no deeper than the last contact plus
+                                // what the node and the face closed since.
+                                let since = (this.steps - last) as f64;
+                                let allowed = this.last_depth[k] + since * closing + margin;
+                                Some((d - allowed).max(0.0))
+                            };
+                            if let Some(offset) = offset {
+                                let h = friction_update(
+                                    stick[k],
+                                    n,
+                                    vrel,
+                                    d - offset,
+                                    face.stiffness,
+                                    mu,
+                                    dt,
+                                );
                                 out.push(Hit {
                                     slave: k as u32,
                                     partner: f as u32,
@@ -570,6 +604,7 @@ impl ContactModel {
                                     tangential_force: h.1,
                                     stiffness: face.stiffness,
                                     penetration: d,
+                                    offset,
                                     elastic: h.2,
                                     dissipated: h.3,
                                     rigid_work: 0.0,
@@ -600,6 +635,7 @@ impl ContactModel {
                                     tangential_force: h.1,
                                     stiffness: kn,
                                     penetration: d,
+                                    offset: 0.0,
                                     elastic: h.2,
                                     dissipated: h.3,
                                     rigid_work: work,
@@ -657,6 +693,9 @@ impl ContactModel {
                 self.stick[k] = h.tangential_force;
                 new_last[k] = h.partner;
                 self.last_contact[k] = self.steps;
+                self.contact_face[k] = h.partner;
+                self.last_depth[k] = h.penetration - h.offset;
+                self.offset[k] = h.offset;
                 for (j, &node) in face.nodes.iter().enumerate() {
                     force[node] = sub(force[node], scale(total, h.weights[j]));
                     let sl = self.surface.slot[node] as usize;
