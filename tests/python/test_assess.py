@@ -279,6 +279,7 @@ def test_report_renders_in_headless_chromium(small_job, tmp_path):
 
 @pytest.mark.parametrize("kwargs, field", [
     (dict(throughput=-1.0), "throughput"), (dict(duration=float("nan")), "duration"),
+    (dict(quick=True, full=True), "quick"),
     (dict(min_speed=-1e-3), "min_speed"), (dict(discard_before=5.0), "discard_before"),
     (dict(stop_after="nope"), "stop_after")])
 def test_bad_parameters_name_the_field(tmp_path, kwargs, field):
