@@ -84,7 +84,15 @@ fn thin_plate_under_a_sudden_point_load_at_0_99_of_the_stable_step() {
         w_max / w_static
     );
     assert!(worst_balance < 1e-3, "energy balance {worst_balance}");
-    assert!(w_max <= 2.0 * w_static * 1.02, "overshoot {}", w_max / w_static);
+    assert!(
+        w_max <= 2.0 * w_static * 1.02,
+        "overshoot {}",
+        w_max / w_static
+    );
     assert!(w_max > 1.5 * w_static, "not dynamic: {}", w_max / w_static);
-    assert!(w_min >= -0.02 * w_static, "rebound past zero: {}", w_min / w_static);
+    assert!(
+        w_min >= -0.02 * w_static,
+        "rebound past zero: {}",
+        w_min / w_static
+    );
 }
