@@ -9,7 +9,7 @@ docs/img/accuracy_cost_*.png. DEM knobs: time-step safety factor (closed-form He
 the table against the finest step), neighbour-list skin, contact law, reduced Young's modulus
 (the paper's trick: which outputs survive), effects switched off. FEM knobs (explicit linear
 tets of the cartridge tube): layers through the wall on a pinch, mass scaling, step safety
-factor. The tet-vs-shell comparison is not made: the shell solver has no Python binding
+factor, and the contact penalty scale (two balls against Hertz). The tet-vs-shell comparison is not made: the shell solver has no Python binding
 (only ``fem_shell_mesh``). SI units throughout.
 """
 from __future__ import annotations
@@ -547,6 +547,70 @@ def knob_fem_safety(quick: bool, img: Path) -> Table:
     return tab
 
 
+def knob_fem_penalty(quick: bool, img: Path) -> Table:
+    """Two equal elastic balls head-on (body-to-body penalty contact, as between cartridges)
+    against Hertz impact theory, for the penalty scale s in k = s K A²/V."""
+    from demfem.fem import Body, ContactOptions, FemModel, ball_tet_mesh
+    from demfem.materials import Material
+
+    r, v, n = 0.01, 2.0, (4 if quick else 6)
+    mat = Material(1e7, 0.3, 1000.0, "soft")
+    m = mat.density * 4.0 / 3.0 * math.pi * r ** 3
+    e_star = mat.E / (2.0 * (1.0 - mat.nu ** 2))
+    k_h = 4.0 / 3.0 * e_star * math.sqrt(0.5 * r)
+    d_max = (5.0 * 0.5 * m * v * v / (4.0 * k_h)) ** 0.4
+    f_h, t_h = k_h * d_max ** 1.5, 2.9432 * d_max / v
+    ball = ball_tet_mesh(r, n)
+    gap = 1e-6 * r
+    tab = Table("FEM contact: penalty scale s, two balls head-on (closed form: Hertz; "
+                "convergence: against s = 100)",
+                ["s", "dt, s", "peak force vs Hertz", "duration vs Hertz", "peak force vs s=100",
+                 "max penetration / r", "energy balance err", "wall s"])
+    runs = {}
+    for s in (0.1, 0.3, 1.0, 3.0, 10.0, 100.0):
+        model = FemModel([Body(ball.placed(None, (0.0, 0.0, -r - gap)), velocity=(0, 0, 0.5 * v),
+                               name="a"),
+                          Body(ball.placed(None, (0.0, 0.0, r + gap)), velocity=(0, 0, -0.5 * v),
+                               name="b")],
+                         mat, contact=ContactOptions(penalty_scale=s, friction=0.0,
+                                                     output_interval=1),
+                         mass_scaling_dt=0.8e-6 * r / 0.01)
+        w0 = time.perf_counter()
+        res = model.run(2.0 * t_h)
+        wall = time.perf_counter() - w0
+        fn, _ = res.pair_force("a", "b", smooth=t_h / 20.0)
+        on = np.flatnonzero(fn > 1e-9 * f_h)
+        dur = float(res.time[on[-1]] - res.time[on[0]]) if on.size else 0.0
+        runs[s] = (float(fn.max()), dur, float(np.nanmax(res.max_penetration)) / r,
+                   res.energy_balance_error(), wall, res.step["dt_s"])
+    f_ref = runs[100.0][0]
+    pts = []
+    for s, (f, dur, pen, eb, wall, dt) in runs.items():
+        tab.rows.append([f"{s:g}", fmt(dt), pct(rel(f, f_h)), pct(rel(dur, t_h)),
+                         pct(rel(f, f_ref)), fmt(pen, 2), fmt(eb, 2), fmt(wall)])
+        if s != 100.0:
+            pts.append((f"s={s:g}", wall, rel(f, f_ref)))
+    tab.note = (f"Balls r = {r * 1e3:g} mm ({ball.n_elements} tets each), E = 10 MPa, ν = 0.3, "
+                f"closing at {v:g} m/s: Hertz F_max = {f_h:.3g} N, duration {t_h:.3g} s. Force "
+                "smoothed over t_c/20 (node-on-facet contact rings at the nodes' frequencies). "
+                "The step is reduced for contact at every s (the certified limit counts the "
+                "penalty springs). What is left against Hertz at large s is the mesh's error "
+                "(a faceted ball of linear tets is not a Hertz sphere), not the penalty's; a "
+                "soft penalty (s < 1) lets nodes sink past half an element, where contact is "
+                "lost, which shows in the energy balance.")
+    tab.image = scatter_plot("fem_penalty", "FEM contact penalty: force error vs cost", pts,
+                             "peak force relative to s = 100", img)
+    ok = [s for s in runs if s != 100.0 and rel(runs[s][0], f_ref) < 0.05 and runs[s][3] < 0.01]
+    tab.recommendation = (
+        (f"Smallest s whose peak force is within 5 % of s = 100 with the energy balance within "
+         f"1 %: {ok[0]:g} ({runs[ok[0]][4]:.2g} s against {runs[100.0][4]:.2g} s at s = 100). "
+         if ok else "No s below 100 is within 5 % of s = 100 with the balance within 1 % on "
+         "this mesh: the mesh, not the penalty, limits the force here. ")
+        + f"The default s = 1 is {rel(runs[1.0][0], f_ref):.2g} from s = 100 and "
+        f"{rel(runs[1.0][0], f_h):.2g} from Hertz; below s = 1 the contact is too soft.")
+    return tab
+
+
 # ============================================================================================
 # The report
 # ============================================================================================
@@ -601,7 +665,8 @@ def main(argv: Optional[list[str]] = None) -> int:
     ap.add_argument("--quick", action="store_true", help="smoke run: reduced table, coarse meshes (<= 5 min)")
     ap.add_argument("--out", default=str(ROOT / "docs" / "accuracy-cost.md"), help="markdown file to write")
     ap.add_argument("--only", nargs="*", default=None, help="knobs to run (default: all): " +
-                    "dt_impact dt_table skin laws modulus effects fem_layers fem_mass_scaling fem_safety")
+                    "dt_impact dt_table skin laws modulus effects fem_layers fem_mass_scaling fem_safety "
+                    "fem_penalty")
     args = ap.parse_args(argv)
     out = Path(args.out)
     img = out.parent / "img"
@@ -617,6 +682,7 @@ def main(argv: Optional[list[str]] = None) -> int:
         "fem_layers": lambda: knob_layers(args.quick, img),
         "fem_mass_scaling": lambda: knob_mass_scaling(args.quick, img),
         "fem_safety": lambda: knob_fem_safety(args.quick, img),
+        "fem_penalty": lambda: knob_fem_penalty(args.quick, img),
     }
     t0 = time.perf_counter()
     tables = []
