@@ -208,14 +208,28 @@ def _cmd_equivalence(args: argparse.Namespace) -> int:
 def _cmd_assess(args: argparse.Namespace) -> int:
     from demfem.assess import assess
 
+    model = None
+    if args.stress_model is not None:
+        from demfem.assess import StressModel
+
+        model = StressModel.load(args.stress_model)
     result = assess(args.scene, out=args.out, duration=args.duration, quick=args.quick,
                     full=args.full, throughput=args.throughput, fresh=args.fresh,
-                    threads=args.threads,
+                    threads=args.threads, stress_model=model,
                     progress=True, log=lambda line: print(line, flush=True))
     s = result["summary"]
     print(f"P per passage: mean {s['p_passage_mean']:.3g}, max {s['p_passage_max']:.3g}; "
           f"expected broken per hour: {s['broken_per_hour']:.3g} (report: {args.out}/"
           "report.html)")
+    return 0
+
+
+def _cmd_stress_model(args: argparse.Namespace) -> int:
+    from demfem.assess.fem_fit import DEFAULT_GRID, QUICK_GRID, fit_from_fem
+
+    fit_from_fem(args.out, grid=QUICK_GRID if args.quick else DEFAULT_GRID, layers=args.layers,
+                 young_modulus=args.young_modulus, scheduler=args.scheduler,
+                 n_workers=args.workers, log=lambda line: print(line, flush=True))
     return 0
 
 
@@ -340,7 +354,21 @@ def build_parser() -> argparse.ArgumentParser:
                    help="DEM engine threads (results are the same on any number)")
     a.add_argument("--fresh", "--overwrite", dest="fresh", action="store_true",
                    help="replace the assessment in --out (its outputs are removed)")
+    a.add_argument("--stress-model", default=None, metavar="MODEL.json",
+                   help="a stress model file (demfem stress-model); default: the shipped "
+                        "closed-form model")
     a.set_defaults(func=_cmd_assess)
+    sm = sub.add_parser("stress-model", help="refit the stress model of demfem assess from a "
+                        "designed grid of FEM two-cartridge collisions, with held-back error")
+    sm.add_argument("--out", default="demfem_out/stress_model", help="output directory; "
+                    "finished FEM runs there are reused")
+    sm.add_argument("--layers", type=int, default=2, help="tet layers through the wall (2)")
+    _add_modulus(sm, "Young's modulus of the glass, Pa (4.5e10)", type=float, default=45e9)
+    sm.add_argument("--quick", action="store_true", help="a 2 x 2 grid instead of 4 x 3")
+    sm.add_argument("--scheduler", default=None, help="Dask scheduler address, or 'serial'; "
+                    "default: a LocalCluster")
+    sm.add_argument("--workers", type=int, default=None, help="LocalCluster worker processes")
+    sm.set_defaults(func=_cmd_stress_model)
     cl = sub.add_parser("cluster", help="FEM of the seven-cartridge cluster (Figs. 10-13): "
                         "forces, sigma1, maps, VTK")
     cl.add_argument("--case", default="max", metavar="max|avg|SCENE.toml",

@@ -5,6 +5,7 @@ shell; the shell's membrane force under a point load tends to −P R/(16 ℓ²);
 Weibull and slow-crack-growth formulas equal demfem.risk's functions.
 """
 import csv
+import dataclasses
 import json
 import math
 import os
@@ -298,3 +299,47 @@ def test_cli_assess_quick(tmp_path, capsys):
     assert err.startswith("demfem: error:") and "throughput_per_hour" in err
     assert main(["assess", "--throughput", "-3", "--out", str(tmp_path / "x")]) == 2
     assert "throughput" in capsys.readouterr().err
+    # another stress model is another assessment: refused in the same folder, named
+    half = dataclasses.replace(StressModel.default(), beta_inner=0.5 * StressModel.default().beta_inner)
+    half.save(tmp_path / "half.json")
+    assert main(["assess", "--quick", "--out", str(out), "--stress-model",
+                 str(tmp_path / "half.json")]) == 2
+    assert "stress_model" in capsys.readouterr().err
+    assert main(["assess", "--quick", "--out", str(tmp_path / "h"), "--stress-model",
+                 str(tmp_path / "half.json")]) == 0
+    lower = json.loads((tmp_path / "h" / "risk.json").read_text())["summary"]
+    first = json.loads((out / "risk.json").read_text())["summary"]
+    assert lower["p_passage_mean"] < first["p_passage_mean"]
+
+
+def test_stress_model_refit_from_a_grid_of_fem_collisions(tmp_path):
+    """The FEM refit: a 4 x 1 grid of crossed-tube collisions (45 GPa, 1 layer, 20 mm tubes),
+    run serially through the sweep, three for training and one held back; the fitted model
+    reproduces its training runs (the scaling σ1 = β F/t² is linear in F), reports its
+    held-back error, loads back, and a rerun reuses the FEM runs."""
+    from demfem.assess.fem_fit import fit_from_fem
+
+    grid = {"v_rel": [0.1, 0.2, 0.3, 0.4], "tilt_deg": [90.0]}
+    lines = []
+    rep = fit_from_fem(tmp_path, grid=grid, layers=1, tube_length=20e-3, scheduler="serial",
+                       log=lines.append)
+    assert rep["n_training"] == 3 and rep["n_held_back"] == 1
+    by_speed = sorted(rep["runs"], key=lambda r: r["v_rel"])
+    forces = [r["max_force_N"] for r in by_speed]
+    assert all(f > 0 for f in forces) and forces == sorted(forces)  # faster, harder
+    assert rep["training_error"]["rms_inner_relative"] < 0.3
+    assert math.isfinite(rep["held_back_error"]["rms_inner_relative"])
+    model = StressModel.load(tmp_path / "stress_model.json")
+    assert model.beta_inner == pytest.approx(rep["model"]["beta_inner"])
+    assert 0 < model.beta_inner < StressModel.default().beta_inner  # 1 layer: far too stiff
+    assert "fitted to 3 FEM collisions" in model.source
+    lines.clear()
+    fit_from_fem(tmp_path, grid=grid, layers=1, tube_length=20e-3, scheduler="serial",
+                 log=lines.append)
+    assert "FEM runs done 4/4" in lines[1]  # all reused
+    with pytest.raises(InvalidParameterError, match="hold_out_every"):
+        fit_from_fem(tmp_path, grid={"v_rel": [0.1], "tilt_deg": [90.0]}, layers=1,
+                     scheduler="serial", log=lines.append)
+    with pytest.raises(InvalidParameterError, match="tilt_deg"):
+        fit_from_fem(tmp_path, grid={"v_rel": [0.1, 0.2]}, scheduler="serial",
+                     log=lines.append)
