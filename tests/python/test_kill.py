@@ -1,6 +1,7 @@
 """kill -9 at any moment loses nothing already written: a `demfem run` or `demfem assess`
-killed after its first DEM checkpoint leaves only complete files, and the same call started
-again resumes and ends with the numbers of an uninterrupted run (issue 30)."""
+killed after its first DEM checkpoint, or a `demfem cluster` FEM run killed after its first
+FEM checkpoint, leaves only complete files, and the same call started again resumes and
+ends with the numbers of an uninterrupted run (issues 28, 30)."""
 import json
 import os
 import signal
@@ -16,6 +17,13 @@ RUN = ("import sys; from demfem.pipeline import run_pipeline; "
        "checkpoint_every=0.3, log=lambda s: None)")
 ASSESS = ("import sys; from demfem.assess import assess; "
           "assess(out=sys.argv[1], duration=0.12, checkpoint_every=0.3, log=lambda s: None)")
+CLUSTER = ("import sys; from demfem.cartridge import Cartridge; from demfem.materials import "
+           "Material; from demfem.scenes import CartridgeCluster; "
+           "from demfem.studies.cluster_run import run_cluster; "
+           "tube = Cartridge.tube(11.6e-3, 1.1e-3, 10e-3, material=Material(1e8, 0.22, 2230.0)); "
+           "c = CartridgeCluster.load_case('max', layers=1, cartridge=tube, springs=True); "
+           "run_cluster(c, duration=8e-4, out=sys.argv[1], progress=False, n_snapshots=4, "
+           "checkpoint_every=0.3, log=print)")
 
 
 def _table_numbers(folder: Path) -> dict:
@@ -44,14 +52,15 @@ def _complete(folder: Path) -> None:
             assert p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", p
 
 
-def _kill_after_checkpoint_and_resume(code: str, tmp_path: Path, final: str) -> tuple[Path, Path]:
+def _kill_after_checkpoint_and_resume(code: str, tmp_path: Path, final: str,
+                                      checkpoint: str = "table.ck.json") -> tuple[Path, Path]:
     """Run ``code`` to the end in ``ref``; in ``killed``, SIGKILL it just after its first
-    DEM checkpoint (checking that ``final`` is not there yet and every file is whole), then
-    run it again to the end. Returns (ref, killed)."""
+    checkpoint (the file ``checkpoint`` appears; ``final`` must not be there yet and every
+    file must be whole), then run it again to the end. Returns (ref, killed)."""
     ref, killed = tmp_path / "ref", tmp_path / "killed"
     subprocess.run([sys.executable, "-c", code, str(ref)], check=True, timeout=600)
     proc = subprocess.Popen([sys.executable, "-c", code, str(killed)])
-    meta = killed / "table.ck.json"
+    meta = killed / checkpoint
     t0 = time.time()
     while not meta.exists() and proc.poll() is None and time.time() - t0 < 300:
         time.sleep(0.05)
@@ -62,8 +71,10 @@ def _kill_after_checkpoint_and_resume(code: str, tmp_path: Path, final: str) -> 
     assert proc.returncode == -signal.SIGKILL
     assert meta.exists() and not (killed / final).exists()
     _complete(killed)
-    subprocess.run([sys.executable, "-c", code, str(killed)], check=True, timeout=600)
+    again = subprocess.run([sys.executable, "-c", code, str(killed)], check=True, timeout=600,
+                           capture_output=True, text=True)
     _complete(killed)
+    (tmp_path / "resume.log").write_text(again.stdout)
     return ref, killed
 
 
@@ -75,3 +86,17 @@ def test_kill_9_after_a_checkpoint_then_resume_gives_the_uninterrupted_numbers(t
 def test_kill_9_of_assess_during_the_dem_then_resume_gives_the_uninterrupted_risk(tmp_path):
     ref, killed = _kill_after_checkpoint_and_resume(ASSESS, tmp_path, "report.html")
     assert _risk_numbers(killed) == _risk_numbers(ref)
+
+
+def test_kill_9_of_a_cluster_run_then_resume_gives_the_uninterrupted_forces(tmp_path):
+    ref, killed = _kill_after_checkpoint_and_resume(CLUSTER, tmp_path, "run.npz",
+                                                    checkpoint="checkpoint.npz")
+    assert (killed / "forces.csv").read_text() == (ref / "forces.csv").read_text()
+    a, b = (json.loads((d / "summary.json").read_text()) for d in (ref, killed))
+    for k in ("steps", "force_peaks", "sigma1_body_max_Pa", "energy_balance_error"):
+        assert a[k] == b[k], k
+    with np.load(ref / "run.npz") as x, np.load(killed / "run.npz") as y:
+        for k in ("sigma1", "pressure", "snap_time", "time"):
+            assert np.array_equal(x[k], y[k]), k
+    assert not (killed / "checkpoint.npz").exists()  # removed once the run is complete
+    assert "resuming from the checkpoint at t = " in (tmp_path / "resume.log").read_text()

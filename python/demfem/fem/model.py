@@ -330,6 +330,20 @@ class FemModel:
                      c.get("friction_work", 0.0), c.get("rigid_work", 0.0),
                      c.get("contact_work", 0.0)])
 
+    def save_state(self, path: Union[str, Path]) -> Path:
+        """Write the run's exact state (displacements, velocities, integrator and contact
+        memory, energies, contact history) to ``path``, atomically. A model built from the
+        same inputs and given :meth:`restore_state` continues bitwise as this one would."""
+        from demfem.io.atomic import write_bytes_atomic
+
+        return write_bytes_atomic(path, bytes(self._solver.save_state()))
+
+    def restore_state(self, path: Union[str, Path]) -> None:
+        """Restore a state written by :meth:`save_state`. A state of another model (other
+        mesh, step, contact or springs) raises :class:`demfem.errors.ShapeError` and leaves
+        this model unchanged."""
+        self._solver.restore_state(Path(path).read_bytes())
+
     def snapshot(self) -> Snapshot:
         """The state now: displacement (N,3) m, element σ1 (E,) Pa, contact pressure (N,) Pa."""
         stress = np.asarray(self._solver.element_stresses())

@@ -19,9 +19,12 @@ runs it (σ1 of cartridge 1 sampled every ``stress_interval`` = 5 µs, since an 
 * ``vtk/cluster_NNNN.vtu`` and ``cluster.pvd``: the VTK series (ParaView);
 * ``summary.json``: peaks, wall time, steps, settings (strict JSON).
 
-Resume: the FEM state cannot be checkpointed, so an interrupted run restarts from t = 0;
-once ``run.npz`` is there, a rerun with the same settings only redoes the figures and
-files. Other settings in the same folder are refused unless ``fresh=True``.
+Resume: every ``checkpoint_every`` s of wall time (30 s) the run saves its exact FEM state
+(``checkpoint.state``: displacements, velocities, contact memory, histories) and what it
+has gathered (``checkpoint.npz``), atomically; a rerun with the same settings after an
+interruption (Ctrl-C, kill -9, power loss) restores it and ends with the numbers of an
+uninterrupted run. Once ``run.npz`` is there, a rerun only redoes the figures and files.
+Other settings in the same folder are refused unless ``fresh=True``.
 """
 from __future__ import annotations
 
@@ -76,12 +79,14 @@ def _diff(a: Any, b: Any, prefix: str = "") -> list[str]:
 def run_cluster(cluster: CartridgeCluster, duration: float = 3e-3,
                 out: Union[str, Path] = "demfem_out/cluster", progress: bool = True,
                 n_snapshots: int = 40, fresh: bool = False,
-                log: Optional[Log] = None, stress_interval: float = 5e-6) -> dict:
+                log: Optional[Log] = None, stress_interval: float = 5e-6,
+                checkpoint_every: float = 30.0) -> dict:
     """Run ``cluster`` for ``duration`` s and write every output into ``out``; returns the
     summary (also ``out/summary.json``). See the module text for the files.
 
     ``n_snapshots`` VTK files at regular times; σ1 of cartridge 1 is sampled every
-    ``stress_interval`` s (5 µs: an impact lasts ~80 µs) for the σ1 curves and maps."""
+    ``stress_interval`` s (5 µs: an impact lasts ~80 µs) for the σ1 curves and maps;
+    ``checkpoint_every``: wall time between checkpoints, s."""
     if not isinstance(cluster, CartridgeCluster):
         raise InvalidParameterError(f"invalid cluster = {cluster!r}: must be a CartridgeCluster")
     duration = check_positive("duration", duration)
@@ -93,6 +98,7 @@ def run_cluster(cluster: CartridgeCluster, duration: float = 3e-3,
     log = log or (lambda line: None)
     out = Path(out)
     check_positive("stress_interval", stress_interval)
+    check_positive("checkpoint_every", checkpoint_every)
     settings = _settings(cluster, duration, n_snapshots)
     settings["stress_interval_s"] = float(stress_interval)
     settings_path, run_path = out / "settings.json", out / "run.npz"
@@ -107,7 +113,8 @@ def run_cluster(cluster: CartridgeCluster, duration: float = 3e-3,
                 f"{out} holds a cluster run with other settings: {'; '.join(diffs[:5])} "
                 "(use another --out, or --fresh to replace it)")
     if fresh and out.exists():
-        for name in ("run.npz", "settings.json", "summary.json", "forces.csv", "cluster.pvd"):
+        for name in ("run.npz", "settings.json", "summary.json", "forces.csv", "cluster.pvd",
+                     *_CHECKPOINT):
             (out / name).unlink(missing_ok=True)
         for p in out.glob("cluster_*"):
             p.unlink(missing_ok=True)
@@ -118,15 +125,57 @@ def run_cluster(cluster: CartridgeCluster, duration: float = 3e-3,
         log(f"reusing the finished FEM run in {run_path} (figures and files are redone)")
         data = dict(np.load(run_path, allow_pickle=False))
     else:
-        data = _simulate(cluster, duration, n_snapshots, out, progress, log, stress_interval)
+        data = _simulate(cluster, duration, n_snapshots, out, progress, log, stress_interval,
+                         checkpoint_every)
         with atomic_path(run_path, suffix=".npz") as tmp:
             np.savez_compressed(tmp, **data)
+        for name in _CHECKPOINT:
+            (out / name).unlink(missing_ok=True)
     return _write_outputs(cluster, data, out, log)
 
 
 # ---------------------------------------------------------------------- the FEM run
+#: The checkpoint's two files: the FEM state, and what the run has gathered (written second;
+#: it names the state's step count, so a state without its record is never used).
+_CHECKPOINT = ("checkpoint.state", "checkpoint.npz")
+
+
+def _save_checkpoint(out: Path, model: Any, k_next: int, wall: float, energy: list,
+                     snaps_t: list, sig: list, press: list, frames: list) -> None:
+    model.save_state(out / _CHECKPOINT[0])
+    en = np.vstack(energy) if energy else np.zeros((0, 10))
+    with atomic_path(out / _CHECKPOINT[1], suffix=".npz") as tmp:
+        np.savez(tmp, k_next=k_next, steps=int(model.solver.steps), wall=wall, energy=en,
+                 energy_rows=np.array([len(e) for e in energy], int),
+                 snap_time=np.asarray(snaps_t, float),
+                 sigma1=np.asarray(sig, np.float32).reshape(len(sig), -1),
+                 pressure=np.asarray(press, np.float32).reshape(len(press), -1),
+                 frame_time=np.array([f[0] for f in frames], float),
+                 frame_name=np.array([f[1] for f in frames], dtype="U64"))
+
+
+def _load_checkpoint(out: Path, model: Any, log: Log) -> Optional[dict]:
+    """Restore the model from the checkpoint in ``out``; its gathered lists, or None."""
+    rec = out / _CHECKPOINT[1]
+    if not rec.exists() or not (out / _CHECKPOINT[0]).exists():
+        return None
+    with np.load(rec, allow_pickle=False) as z:
+        c = {k: z[k] for k in z.files}
+    model.restore_state(out / _CHECKPOINT[0])
+    if int(model.solver.steps) != int(c["steps"]):
+        raise SettingsMismatchError(
+            f"{out}: checkpoint.state is at step {int(model.solver.steps)}, its record at "
+            f"{int(c['steps'])}; remove both (or use --fresh)")
+    rows = np.cumsum(np.concatenate([[0], c["energy_rows"]]))
+    c["energy_list"] = [c["energy"][a:b] for a, b in zip(rows[:-1], rows[1:])]
+    log(f"cluster: resuming from the checkpoint at t = {model.time * 1e3:.4g} ms "
+        f"(step {int(c['steps'])})")
+    return c
+
+
 def _simulate(cluster: CartridgeCluster, duration: float, n_snapshots: int, out: Path,
-              progress: bool, log: Log, stress_interval: float) -> dict:
+              progress: bool, log: Log, stress_interval: float,
+              checkpoint_every: float = 30.0) -> dict:
     from demfem import _core
     from demfem.fem.result import FemResult
     from demfem.io.vtk import write_pvd
@@ -158,8 +207,19 @@ def _simulate(cluster: CartridgeCluster, duration: float, n_snapshots: int, out:
     frames: list[Any] = []
     t_wall = _time.perf_counter()
     steps0 = int(model.solver.steps)
+    k_start, wall_before = 0, 0.0
+    saved = _load_checkpoint(out, model, log)
+    if saved is not None:
+        k_start, wall_before = int(saved["k_next"]), float(saved["wall"])
+        energy = list(saved["energy_list"])
+        snaps_t = [float(x) for x in saved["snap_time"]]
+        sig, press = list(saved["sigma1"]), list(saved["pressure"])
+        frames = [(float(t), str(n)) for t, n in zip(saved["frame_time"], saved["frame_name"])]
+    last_save = _time.perf_counter()
     try:
-        for t_target in targets:
+        for k, t_target in enumerate(targets):
+            if k < k_start:
+                continue
             left = t_target - model.time
             if left > 0.5 * model.dt_step:
                 cb = (lambda done, t: bar(t, int(model.solver.steps) - steps0)) if bar else False
@@ -175,16 +235,21 @@ def _simulate(cluster: CartridgeCluster, duration: float, n_snapshots: int, out:
                 name = f"cluster_{len(frames):04d}.vtu"
                 model.write_vtu(vtk / name)
                 frames.append((model.time, f"vtk/{name}"))
+            if _time.perf_counter() - last_save >= checkpoint_every and k + 1 < len(targets):
+                _save_checkpoint(out, model, k + 1, wall_before + _time.perf_counter() - t_wall,
+                                 energy, snaps_t, sig, press, frames)
+                last_save = _time.perf_counter()
     except SimulationInterrupted:
         if bar is not None:
             bar.close()
+        where = ("the last checkpoint" if (out / _CHECKPOINT[1]).exists() else "t = 0 (no "
+                 "checkpoint yet)")
         raise SimulationInterrupted(
             f"cluster run stopped at t = {model.time * 1e3:.3g} ms of {duration * 1e3:.3g} ms; "
-            "no outputs written (the FEM state cannot be checkpointed: a rerun restarts at "
-            "t = 0)") from None
+            f"the same command resumes from {where}") from None
     if bar is not None:
         bar.close()
-    wall = _time.perf_counter() - t_wall
+    wall = wall_before + _time.perf_counter() - t_wall
     write_pvd(out / "cluster.pvd", frames)
     en = np.vstack(energy) if energy else np.zeros((0, 10))
     res = FemResult.from_model(model, en, [], 0.0)

@@ -5,7 +5,7 @@
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyBytes, PyDict};
 
 use demfem::fem::io::vtk::{write_vtu, DataArray};
 use demfem::fem::stable_step::StepBound;
@@ -506,7 +506,10 @@ impl FemTetSolver {
     /// Contact output channels: list of (party a, party b, region of a), a < b (bodies
     /// first, then rigid surfaces in the order given).
     fn contact_channels(&self) -> Vec<(usize, usize, usize)> {
-        self.inner.contact().map(|c| c.channels()).unwrap_or_default()
+        self.inner
+            .contact()
+            .map(|c| c.channels())
+            .unwrap_or_default()
     }
     /// Contact history (samples, 1 + 4·channels): time s, then per channel the normal and
     /// tangential resultant force N, contact area m², largest penetration m.
@@ -534,13 +537,31 @@ impl FemTetSolver {
     /// eigenvalue_allowance (1/s²), max_contact_eigenvalue (1/s²), dt_limit_without_contact (s).
     fn contact_info<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
         match self.inner.contact() {
-            Some(c) => Ok(Some(fem_contact::info(py, c, self.inner.dt_limit_without_contact())?)),
+            Some(c) => Ok(Some(fem_contact::info(
+                py,
+                c,
+                self.inner.dt_limit_without_contact(),
+            )?)),
             None => Ok(None),
         }
     }
     /// Lumped nodal masses (N,), kg.
     fn mass<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         self.inner.mass().to_vec().into_pyarray(py)
+    }
+
+    /// The run's dynamic state (contact included) as bytes, for an exact checkpoint.
+    fn save_state<'py>(&self, py: Python<'py>) -> Bound<'py, PyBytes> {
+        PyBytes::new(py, &self.inner.save_state())
+    }
+
+    /// Restore a state from :meth:`save_state` into a solver built from the same inputs;
+    /// a state of another model raises ShapeError and changes nothing.
+    fn restore_state(&mut self, state: &[u8]) -> PyResult<()> {
+        Ok(self
+            .inner
+            .restore_state(state)
+            .map_err(PyDemfemError::from)?)
     }
 
     /// Time step in use, s.

@@ -21,11 +21,13 @@
 //! one the scheme conserves; it differs from ½ v·Mv at the same instant by O((ωΔt)²) per
 //! mode. At n = 0, v^{−½} := v^0 − (Δt/2) a^0.
 
+mod state;
+
 use rayon::prelude::*;
 
 use crate::error::{check_non_negative, check_open, check_positive, DemfemError, Result};
-use crate::fem::contact::{ContactEnergy, ContactModel};
 use crate::fem::assembly::{lumped_mass, precompute_tets, NodeAdjacency};
+use crate::fem::contact::{ContactEnergy, ContactModel};
 use crate::fem::element::Tet4;
 use crate::fem::material::LinearElastic;
 use crate::fem::mesh::{tet_quality, TetMesh};
@@ -434,7 +436,10 @@ fn check_element_shapes(mesh: &TetMesh) -> Result<()> {
         if !(q.volume >= MIN_ELEMENT_VOLUME_FRACTION * mean) {
             return Err(DemfemError::InvalidParameter {
                 field: "mesh".into(),
-                value: format!("element {e} has volume {:e} m³ (mean {mean:e} m³)", q.volume),
+                value: format!(
+                    "element {e} has volume {:e} m³ (mean {mean:e} m³)",
+                    q.volume
+                ),
                 allowed: format!(
                     "elements of volume >= {MIN_ELEMENT_VOLUME_FRACTION:e} × the mean"
                 ),
@@ -683,7 +688,10 @@ impl ExplicitSolver {
     }
     /// Contact energies (zero without contact).
     pub fn contact_energy(&self) -> ContactEnergy {
-        self.contact.as_ref().map(|c| c.energy()).unwrap_or_default()
+        self.contact
+            .as_ref()
+            .map(|c| c.energy())
+            .unwrap_or_default()
     }
     /// Stable step bound without the contact's allowance, s.
     pub fn dt_limit_without_contact(&self) -> f64 {

@@ -22,6 +22,7 @@ pub mod material;
 pub mod mesh;
 pub mod shell;
 pub mod stable_step;
+pub mod state_io;
 pub mod static_solve;
 pub mod stress;
 

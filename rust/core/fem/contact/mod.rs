@@ -37,6 +37,7 @@
 mod broad_phase;
 mod rigid;
 mod springs;
+mod state;
 mod surface;
 mod vec3;
 

@@ -1,0 +1,123 @@
+//! Save and restore the explicit solver's dynamic state, contact included (see
+//! [`crate::fem::state_io`]): build the solver from the same inputs, call
+//! [`ExplicitSolver::restore_state`], and the run continues bitwise where it was saved.
+
+use crate::error::{DemfemError, Result};
+use crate::fem::state_io::{StateReader, StateWriter};
+
+use super::{EnergyReport, ExplicitSolver};
+
+fn report_to(e: &EnergyReport) -> [f64; 6] {
+    [
+        e.time,
+        e.kinetic,
+        e.internal,
+        e.external_work,
+        e.damping_work,
+        e.initial,
+    ]
+}
+
+fn report_from(c: &[f64]) -> EnergyReport {
+    EnergyReport {
+        time: c[0],
+        kinetic: c[1],
+        internal: c[2],
+        external_work: c[3],
+        damping_work: c[4],
+        initial: c[5],
+    }
+}
+
+impl ExplicitSolver {
+    /// The dynamic state as bytes: displacements, velocities, the force and work memory of
+    /// the integrator, time, steps, energies, and the contact model's state.
+    pub fn save_state(&self) -> Vec<u8> {
+        let mut w = StateWriter::new();
+        w.vec3s("u", &self.u);
+        w.vec3s("v", &self.v);
+        w.vec3s("f_int", &self.f_int);
+        w.vec3s("f_damp", &self.f_damp);
+        w.vec3s("f_ext", &self.f_ext);
+        w.vec3s("f_total_prev", &self.f_total_prev);
+        w.vec3s("f_damp_prev", &self.f_damp_prev);
+        w.vec3s("du_prev", &self.du_prev);
+        w.vec3s("extra_loads", &self.extra_loads);
+        w.vec3s("f_contact", &self.f_contact);
+        w.f64s("clock", &[self.time, self.dt]);
+        w.u64s("steps", &[self.steps]);
+        w.f64s("energy", &report_to(&self.energy));
+        let hist: Vec<f64> = self.history.iter().flat_map(report_to).collect();
+        w.f64s("energy_history", &hist);
+        w.u64s("has_contact", &[u64::from(self.contact.is_some())]);
+        if let Some(c) = &self.contact {
+            c.save_state(&mut w);
+        }
+        w.finish()
+    }
+
+    /// Restore a state saved by [`Self::save_state`] from a solver built from the same
+    /// mesh, material, settings and contact. A state of another model (other sizes, another
+    /// step, contact present or not) is refused and nothing changes.
+    pub fn restore_state(&mut self, bytes: &[u8]) -> Result<()> {
+        let mut r = StateReader::new(bytes)?;
+        let n = self.u.len();
+        let u = r.vec3s("u", Some(n))?;
+        let v = r.vec3s("v", Some(n))?;
+        let f_int = r.vec3s("f_int", Some(n))?;
+        let f_damp = r.vec3s("f_damp", Some(n))?;
+        let f_ext = r.vec3s("f_ext", Some(n))?;
+        let f_total_prev = r.vec3s("f_total_prev", Some(n))?;
+        let f_damp_prev = r.vec3s("f_damp_prev", Some(n))?;
+        let du_prev = r.vec3s("du_prev", Some(n))?;
+        let extra_loads = r.vec3s("extra_loads", Some(n))?;
+        let f_contact = r.vec3s("f_contact", Some(self.f_contact.len()))?;
+        let clock = r.f64s("clock", Some(2))?;
+        let steps = r.u64s("steps", Some(1))?;
+        let energy = r.f64s("energy", Some(6))?;
+        let hist = r.f64s("energy_history", None)?;
+        let has_contact = r.u64s("has_contact", Some(1))?[0] == 1;
+        let mismatch = |detail: String| DemfemError::ShapeMismatch {
+            field: "saved state".into(),
+            detail,
+        };
+        if clock[1].to_bits() != self.dt.to_bits() {
+            return Err(mismatch(format!(
+                "saved with the step {:e} s, this solver steps {:e} s (other settings)",
+                clock[1], self.dt
+            )));
+        }
+        if has_contact != self.contact.is_some() || hist.len() % 6 != 0 {
+            return Err(mismatch(
+                "contact present in one of the saved state and this solver only".into(),
+            ));
+        }
+        let contact = match &self.contact {
+            Some(c) => {
+                let mut c = c.clone();
+                c.restore_state(&mut r)?;
+                Some(c)
+            }
+            None => None,
+        };
+        r.finish()?;
+        self.u = u;
+        self.v = v;
+        self.f_int = f_int;
+        self.f_damp = f_damp;
+        self.f_ext = f_ext;
+        self.f_total_prev = f_total_prev;
+        self.f_damp_prev = f_damp_prev;
+        self.du_prev = du_prev;
+        self.extra_loads = extra_loads;
+        self.f_contact = f_contact;
+        self.time = clock[0];
+        self.steps = steps[0];
+        self.energy = report_from(&energy);
+        self.history = hist.chunks_exact(6).map(report_from).collect();
+        if contact.is_some() {
+            self.contact = contact;
+        }
+        Ok(())
+    }
+}
