@@ -165,6 +165,30 @@ def test_per_event_probabilities_match_demfem_risk():
                                ).tolist() == [0.0, 0.0]
 
 
+def test_wall_and_gate_impacts_are_events_and_the_belt_is_not():
+    """Sphere-wall onsets become wall events (partner 1, j = -1, the wall's index, the
+    contact point), filtered by the same minimum speed; onsets on the belt (a cartridge
+    standing on its base) are counted but are not events."""
+    from types import SimpleNamespace
+
+    from demfem.analysis.collisions import ONSET_DTYPE, WALL_ONSET_DTYPE
+    from demfem.assess.events import impact_events
+
+    w = np.zeros(4, WALL_ONSET_DTYPE)
+    w["i"], w["wall"], w["time"] = [3, 4, 5, 6], [0, 5, 4, 5], [0.1, 0.2, 0.3, 0.4]
+    w["normal_speed"] = [0.5, 0.08, 0.001, 0.02]
+    w["x"], w["y"] = [0.1, 0.2, 0.3, 0.4], [0.01, 0.02, 0.03, 0.04]
+    run = SimpleNamespace(onsets=np.zeros(0, ONSET_DTYPE), wall_onsets=w,
+                          info={"wall_names": ["belt", "back", "lower_side", "upper_side",
+                                               "tilted", "gate"]})
+    ev, summary = impact_events(run, min_speed=5e-3)
+    assert list(ev["i"]) == [4, 6] and set(ev["j"]) == {-1} and set(ev["partner"]) == {1}
+    assert list(ev["wall"]) == [5, 5] and list(ev["x"]) == [0.2, 0.4]
+    assert summary["n_wall_events"] == 2 and summary["wall_events"]["gate"] == 2
+    assert summary["n_belt_contacts"] == 1 and summary["n_dropped"] == 1
+    assert summary["n_onsets"] == 4
+
+
 # ---- the job ---------------------------------------------------------------------------------
 
 @pytest.fixture(scope="module")
@@ -212,6 +236,10 @@ def test_outputs_and_report(small_job):
     rows = list(csv.DictReader(open(out / "events.csv")))
     assert len(rows) == doc["events"]["n_events"]
     assert all(float(r["normal_speed_m_per_s"]) >= 5e-3 for r in rows)
+    walls = [r for r in rows if r["partner"] == "wall"]
+    assert walls and all(r["j"] == "-1" and int(r["wall"]) > 0 for r in walls)  # never the belt
+    assert doc["events"]["n_wall_events"] == len(walls)
+    assert 0.0 <= doc["summary"]["wall_share"] <= 1.0
     cart = list(csv.DictReader(open(out / "cartridges.csv")))
     assert len(cart) == SMALL.n_spheres
     p = np.array([float(r["p_passage"]) for r in cart])

@@ -12,6 +12,7 @@ from demfem.errors import InvalidParameterError, ShapeError
 
 __all__ = [
     "ONSET_DTYPE",
+    "WALL_ONSET_DTYPE",
     "collision_onset_table",
     "onset_histogram",
     "onset_quantiles",
@@ -25,6 +26,19 @@ ONSET_DTYPE = np.dtype([
     ("tangential_speed", "f8"),
     ("impact_angle", "f8"),
     ("coordination_i", "i8"), ("coordination_j", "i8"),
+])
+
+#: Fields of the sphere-wall onset table: sphere i, wall index (into the run's
+#: ``info["wall_names"]``), time (s), normal and tangential speed relative to the wall's
+#: surface (m/s), impact angle (rad), contact point on the wall (m), coordination of i.
+WALL_ONSET_DTYPE = np.dtype([
+    ("i", "i8"), ("wall", "i8"),
+    ("time", "f8"),
+    ("normal_speed", "f8"),
+    ("tangential_speed", "f8"),
+    ("impact_angle", "f8"),
+    ("x", "f8"), ("y", "f8"), ("z", "f8"),
+    ("coordination_i", "i8"),
 ])
 
 _NUMERIC_FIELDS = ("time", "normal_speed", "tangential_speed", "impact_angle",

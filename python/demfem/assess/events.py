@@ -1,11 +1,14 @@
 """Impact events from a DEM run: one row per contact onset hard enough to matter.
 
-What the record holds: :func:`demfem.studies.table_run.run_table` logs every
-**sphere–sphere** contact onset (partners i and j, time, normal and tangential relative speed
-at onset); it drops the onsets against walls, the belt and the gate. Every event built here is
-therefore partner type ``"sphere"``; the event table and the stress model carry a partner code
-(:data:`demfem.assess.impact.PARTNERS`) so that wall events, once recorded, go through the same
-path with a flat wall partner.
+What the record holds: :func:`demfem.studies.table_run.run_table` logs every contact onset,
+sphere–sphere (partners i and j) and sphere–wall (the wall's index and the contact point), with
+the time and the normal and tangential relative speed at onset (against a moving wall, the gate,
+relative to its surface). Sphere–sphere events are partner type ``"sphere"``; impacts on the
+side walls, the back, the tilted wall and the gate are partner type ``"wall"`` (a flat glass
+half-space in the stress stage, :data:`demfem.assess.impact.PARTNERS`). Contacts with the belt
+are not events: the equivalent sphere on the belt is a cartridge standing on its base, loaded
+along its axis, not the side-wall impact the stress model describes (walls named in
+:data:`NOT_IMPACTS`).
 
 Position: the record samples the centres every ``sample_interval``; the centres of i and j at
 the onset time are interpolated linearly between the two samples around it (nearest sample if
@@ -28,17 +31,21 @@ import numpy as np
 
 from demfem.errors import check_range
 
-__all__ = ["EVENT_DTYPE", "DEFAULT_MIN_SPEED", "impact_events", "events_of_cartridge",
-           "events_per_cartridge", "write_events_csv"]
+__all__ = ["EVENT_DTYPE", "DEFAULT_MIN_SPEED", "NOT_IMPACTS", "impact_events",
+           "events_of_cartridge", "events_per_cartridge", "write_events_csv"]
+
+#: Walls whose contacts are not side impacts on a cartridge (the floor it stands on).
+NOT_IMPACTS = ("belt",)
 
 #: Default minimum normal impact speed of an event, m/s.
 DEFAULT_MIN_SPEED = 5e-3
 
 #: Fields of the event table: partners i, j (j = -1 for a wall), partner code (0 sphere,
-#: 1 wall), onset time (s), contact point (m), normal and tangential relative speed at onset
-#: (m/s), impact angle atan2(v_t, v_n) (rad).
+#: 1 wall), the wall's index in the run's ``info["wall_names"]`` (-1 for a sphere), onset
+#: time (s), contact point (m), normal and tangential relative speed at onset (m/s), impact
+#: angle atan2(v_t, v_n) (rad).
 EVENT_DTYPE = np.dtype([
-    ("i", "i8"), ("j", "i8"), ("partner", "i8"), ("time", "f8"),
+    ("i", "i8"), ("j", "i8"), ("partner", "i8"), ("wall", "i8"), ("time", "f8"),
     ("x", "f8"), ("y", "f8"), ("z", "f8"),
     ("normal_speed", "f8"), ("tangential_speed", "f8"), ("impact_angle", "f8"),
 ])
@@ -65,9 +72,11 @@ def _centres_at(run, t: np.ndarray, idx: np.ndarray) -> np.ndarray:
 
 def impact_events(run, min_speed: float = DEFAULT_MIN_SPEED) -> tuple[np.ndarray, dict[str, Any]]:
     """The impact events of a :class:`~demfem.studies.table_run.TableRun` with a normal
-    speed ≥ ``min_speed`` (m/s, ≥ 0), in time order, as an array of :data:`EVENT_DTYPE`;
-    and a summary: ``n_onsets`` (all recorded onsets), ``n_events``, ``n_dropped``,
-    ``max_dropped_speed_m_per_s``, ``min_speed_m_per_s``, ``partners_recorded``."""
+    speed ≥ ``min_speed`` (m/s, ≥ 0), sphere–sphere and sphere–wall (not the belt), in time
+    order, as an array of :data:`EVENT_DTYPE`; and a summary: ``n_onsets`` (all recorded
+    onsets, belt contacts included), ``n_events`` (of which ``n_wall_events``, and per wall
+    ``wall_events``), ``n_dropped``, ``max_dropped_speed_m_per_s``, ``min_speed_m_per_s``,
+    ``partners_recorded``, ``note``."""
     v_min = check_range("min_speed", min_speed, 0.0, math.inf, lo_open=False)
     o = run.onsets
     keep = np.asarray(o["normal_speed"], float) >= v_min
@@ -75,7 +84,7 @@ def impact_events(run, min_speed: float = DEFAULT_MIN_SPEED) -> tuple[np.ndarray
     ev = np.zeros(len(sel), EVENT_DTYPE)
     for k in ("i", "j", "time", "normal_speed", "tangential_speed", "impact_angle"):
         ev[k] = sel[k]
-    ev["partner"] = 0
+    ev["partner"], ev["wall"] = 0, -1
     if len(sel):
         t = np.asarray(sel["time"], float)
         ci = _centres_at(run, t, np.asarray(sel["i"]))
@@ -85,15 +94,36 @@ def impact_events(run, min_speed: float = DEFAULT_MIN_SPEED) -> tuple[np.ndarray
         unit = np.where(norm[:, None] > 0, d / np.where(norm > 0, norm, 1.0)[:, None], 0.0)
         point = ci + np.asarray(run.radii, float)[np.asarray(sel["i"])][:, None] * unit
         ev["x"], ev["y"], ev["z"] = point[:, 0], point[:, 1], point[:, 2]
+    names = [str(n) for n in run.info.get("wall_names", [])]
+    w = np.asarray(run.wall_onsets)
+    impact_wall = np.array([names[int(k)] not in NOT_IMPACTS if int(k) < len(names) else True
+                            for k in w["wall"]], bool) if len(w) else np.zeros(0, bool)
+    w_speed = np.asarray(w["normal_speed"], float)
+    w_keep = impact_wall & (w_speed >= v_min)
+    ws = w[w_keep]
+    wev = np.zeros(len(ws), EVENT_DTYPE)
+    for k in ("i", "wall", "time", "normal_speed", "tangential_speed", "impact_angle",
+              "x", "y", "z"):
+        wev[k] = ws[k]
+    wev["j"], wev["partner"] = -1, 1
+    ev = np.concatenate([ev, wev])
     ev = ev[np.argsort(ev["time"], kind="stable")]
-    dropped = np.asarray(o["normal_speed"], float)[~keep]
-    summary = {"n_onsets": int(len(o)), "n_events": int(len(ev)),
+    dropped = np.concatenate([np.asarray(o["normal_speed"], float)[~keep],
+                              w_speed[impact_wall & ~w_keep]])
+    per_wall = {n: int(np.sum(ws["wall"] == k)) for k, n in enumerate(names)
+                if n not in NOT_IMPACTS}
+    n_belt = int(len(w) - impact_wall.sum())
+    summary = {"n_onsets": int(len(o) + len(w)), "n_events": int(len(ev)),
+               "n_wall_events": int(len(wev)), "wall_events": per_wall,
+               "n_belt_contacts": n_belt,
                "n_dropped": int(len(dropped)),
                "max_dropped_speed_m_per_s": float(dropped.max()) if len(dropped) else 0.0,
                "min_speed_m_per_s": v_min,
-               "partners_recorded": ["sphere"],
-               "note": "run_table records sphere-sphere onsets only (wall, belt and gate "
-                       "contacts are not in the record)"}
+               "partners_recorded": ["sphere", "wall"] if names else ["sphere"],
+               "note": (f"sphere-sphere and sphere-wall impacts (walls: "
+                        f"{', '.join(per_wall) or 'none recorded'}); the {n_belt} onsets on the "
+                        "belt are cartridges standing on their base, not side impacts, and "
+                        "are not events")}
     return ev, summary
 
 
@@ -119,13 +149,14 @@ def write_events_csv(path, events: np.ndarray, extra: dict[str, np.ndarray]) -> 
     from demfem.assess.impact import PARTNERS
     from demfem.io.atomic import write_text_atomic
 
-    head = ["event", "i", "j", "partner", "time_s", "x_m", "y_m", "z_m",
+    head = ["event", "i", "j", "partner", "wall", "time_s", "x_m", "y_m", "z_m",
             "normal_speed_m_per_s", "tangential_speed_m_per_s", "impact_angle_deg",
             *extra.keys()]
     lines = [",".join(head)]
     cols = list(extra.values())
     for k, e in enumerate(events):
         row = [str(k), str(int(e["i"])), str(int(e["j"])), PARTNERS[int(e["partner"])],
+               str(int(e["wall"])),
                f"{e['time']:.9g}", f"{e['x']:.6g}", f"{e['y']:.6g}", f"{e['z']:.6g}",
                f"{e['normal_speed']:.6g}", f"{e['tangential_speed']:.6g}",
                f"{math.degrees(e['impact_angle']):.4g}"]

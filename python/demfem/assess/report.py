@@ -65,15 +65,17 @@ def render_report(risk: dict[str, Any], figures: dict[str, bytes],
         ("throughput (planning assumption), cartridges/h", s["throughput_per_hour"]),
         ("expected broken per hour, 1/h", s["broken_per_hour"]),
         ("share of the hazard from the inner surface", s["inner_share"]),
+        ("impacts on walls and gate in the window", s["n_wall_events_window"]),
+        ("share of the hazard from wall and gate impacts", s["wall_share"]),
         ("largest peak contact force in the window, N", s["max_force_N"]),
         ("largest inner σ1 in the window, Pa", s["max_sigma_inner_Pa"]),
         ("largest outer σ1 in the window, Pa", s["max_sigma_outer_Pa"]),
     ], cls="summary"))
-    parts.append("<h2>Worst collisions</h2><table><tr><th>event</th><th>cartridges</th>"
+    parts.append("<h2>Worst collisions</h2><table><tr><th>event</th><th>cartridge – partner</th>"
                  "<th>time, s</th><th>x, y, m</th><th>v_n, m/s</th><th>F, N</th>"
                  "<th>σ1 inner, MPa</th><th>σ1 outer, MPa</th><th>P_k</th></tr>")
     for r in risk["worst_events"]:
-        parts.append(f"<tr><td>{r['event']}</td><td>{r['i']} – {r['j']} ({r['partner']})</td>"
+        parts.append(f"<tr><td>{r['event']}</td><td>{r['i']} – {html.escape(r['with'])}</td>"
                      f"<td>{r['time_s']:.4g}</td><td>{r['x_m']:.3f}, {r['y_m']:.3f}</td>"
                      f"<td>{r['normal_speed_m_per_s']:.3g}</td><td>{r['force_N']:.3g}</td>"
                      f"<td>{r['sigma_inner_Pa'] / 1e6:.3g}</td>"

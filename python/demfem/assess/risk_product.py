@@ -74,7 +74,8 @@ def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[st
     n = run.n_particles
     cr = cartridge_risk(events, p["p_event"], n, run.removal_times, window, throughput)
     steady = steady_state(events, p["p_event"], window)
-    worst = worst_events(events, p, stress, window)
+    wall_names = [str(x) for x in run.info.get("wall_names", [])]
+    worst = worst_events(events, p, stress, window, wall_names=wall_names)
     pos = run.positions[np.isfinite(run.positions[..., 0])]
     pad = float(np.max(run.radii))
     extent = (float(pos[:, 0].min()) - pad, float(pos[:, 0].max()) + pad,
@@ -83,6 +84,11 @@ def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[st
     inside = (events["time"] >= window[0]) & (events["time"] <= window[1])
     h_in = float(-np.log1p(-p["p_inner"][inside]).sum())
     h_out = float(-np.log1p(-p["p_outer"][inside]).sum())
+    hazard = -np.log1p(-p["p_event"])
+    h_all = float(hazard[inside].sum())
+    by_wall = {name: float(hazard[inside & (events["wall"] == k)].sum()) / h_all
+               for k, name in enumerate(wall_names)
+               if h_all > 0 and np.any(inside & (events["wall"] == k))}
     present = cr["exposure_s"] > 0
     w = cr["window_s"]
 
@@ -100,6 +106,10 @@ def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[st
         "throughput_per_hour": throughput, "broken_per_hour": cr["broken_per_hour"],
         "broken_per_hour_small_p": cr["broken_per_hour_small_p"],
         "inner_share": h_in / (h_in + h_out) if h_in + h_out > 0 else math.nan,
+        "n_wall_events_window": int(np.sum(inside & (events["partner"] == 1))),
+        "wall_share": (float(hazard[inside & (events["partner"] == 1)].sum()) / h_all
+                       if h_all > 0 else math.nan),
+        "wall_share_by_wall": by_wall,
         "max_force_N": mx(stress["force_N"][inside]),
         "max_sigma_inner_Pa": mx(stress["sigma_inner_Pa"][inside]),
         "max_sigma_outer_Pa": mx(stress["sigma_outer_Pa"][inside]),

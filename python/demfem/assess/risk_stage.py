@@ -35,7 +35,7 @@ SI units: Pa, m², s; rates per second unless named per hour.
 from __future__ import annotations
 
 import math
-from typing import Any, Optional
+from typing import Any, Optional, Sequence
 
 import numpy as np
 
@@ -173,8 +173,10 @@ def steady_state(events: np.ndarray, p_event: np.ndarray,
 
 
 def worst_events(events: np.ndarray, p: dict[str, np.ndarray], stress: dict[str, np.ndarray],
-                 window: tuple[float, float], count: int = 10) -> list[dict[str, Any]]:
-    """The ``count`` events of the window with the largest P_k, as rows (SI units in keys)."""
+                 window: tuple[float, float], count: int = 10,
+                 wall_names: Sequence[str] = ()) -> list[dict[str, Any]]:
+    """The ``count`` events of the window with the largest P_k, as rows (SI units in keys);
+    ``with`` names the partner: ``cartridge j`` or the wall (``wall_names`` by index)."""
     from demfem.assess.impact import PARTNERS
 
     inside = np.flatnonzero((events["time"] >= window[0]) & (events["time"] <= window[1]))
@@ -182,8 +184,12 @@ def worst_events(events: np.ndarray, p: dict[str, np.ndarray], stress: dict[str,
     rows = []
     for k in order:
         e = events[k]
+        w = int(e["wall"])
+        with_ = (f"cartridge {int(e['j'])}" if int(e["partner"]) == 0 else
+                 (wall_names[w] if 0 <= w < len(wall_names) else "wall"))
         rows.append({"event": int(k), "i": int(e["i"]), "j": int(e["j"]),
-                     "partner": PARTNERS[int(e["partner"])], "time_s": float(e["time"]),
+                     "partner": PARTNERS[int(e["partner"])], "with": with_,
+                     "time_s": float(e["time"]),
                      "x_m": float(e["x"]), "y_m": float(e["y"]),
                      "normal_speed_m_per_s": float(e["normal_speed"]),
                      "force_N": float(stress["force_N"][k]),

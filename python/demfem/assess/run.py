@@ -222,8 +222,9 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
     data = _load_npz(ev_path)
     events = data["events"].astype(EVENT_DTYPE)
     ev_summary = json.loads(str(data["summary"]))
-    log(f"  {ev_summary['n_events']} events of {ev_summary['n_onsets']} onsets "
-        f"({ev_summary['n_dropped']} below {v_min:g} m/s dropped)")
+    log(f"  {ev_summary['n_events']} events ({ev_summary.get('n_wall_events', 0)} on walls "
+        f"and the gate) of {ev_summary['n_onsets']} onsets ({ev_summary['n_dropped']} below "
+        f"{v_min:g} m/s dropped)")
     if stop_after == "events":
         return {"stopped_after": "events"}
 

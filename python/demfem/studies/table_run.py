@@ -26,7 +26,7 @@ from typing import Any, Callable, Mapping, Optional
 
 import numpy as np
 
-from demfem.analysis.collisions import ONSET_DTYPE
+from demfem.analysis.collisions import ONSET_DTYPE, WALL_ONSET_DTYPE
 from demfem.analysis.forces import first_line_force, force_statistics
 from demfem.analysis.coordination import mean_coordination
 from demfem.errors import (CheckpointError, DemfemIOError, InvalidParameterError,
@@ -69,7 +69,11 @@ class TableRun:
         onsets: particle-particle contact onsets, :data:`demfem.analysis.ONSET_DTYPE` (speeds in
             m/s as the engine logs them, impact angle atan2(v_t, v_n) in rad, coordination of
             both partners at the sample nearest the onset).
-        info: run metadata: model, dt (s), effects, steps, wall_time_s, completed.
+        info: run metadata: model, dt (s), effects, steps, wall_time_s, completed, and
+            ``wall_names`` (the scene's walls in engine order).
+        wall_onsets: sphere-wall contact onsets (belt, side walls, tilted wall, gate),
+            :data:`demfem.analysis.collisions.WALL_ONSET_DTYPE`; empty for runs saved before
+            they were recorded.
     """
 
     parameters: dict[str, Any]
@@ -87,6 +91,7 @@ class TableRun:
     removal_times: np.ndarray
     onsets: np.ndarray
     info: dict[str, Any] = field(default_factory=dict)
+    wall_onsets: np.ndarray = field(default_factory=lambda: np.zeros(0, WALL_ONSET_DTYPE))
 
     @property
     def n_frames(self) -> int:
@@ -139,7 +144,7 @@ class TableRun:
         """Write the run to ``path`` (``.npz``) atomically; returns the path."""
         arrays = {name: getattr(self, name) for name in _ARRAYS}
         arrays.update(tags=self.tags, radii=self.radii, removal_times=self.removal_times,
-                      onsets=self.onsets)
+                      onsets=self.onsets, wall_onsets=self.wall_onsets)
         document = json_dumps({"parameters": self.parameters, "info": self.info})
         target = Path(path)
         with atomic_path(target, suffix=".npz") as tmp:
@@ -164,6 +169,8 @@ class TableRun:
         if missing:
             raise InvalidParameterError(f"invalid table run file {path}: missing "
                                         + ", ".join(missing))
+        if "wall_onsets" not in arrays:  # a run saved before wall onsets were recorded
+            arrays["wall_onsets"] = np.zeros(0, WALL_ONSET_DTYPE)
         return cls(parameters=document["parameters"], info=document["info"], **arrays)
 
     def summary(self, discard_before: float = 0.0, quantile: float = 0.95) -> dict[str, float]:
@@ -209,6 +216,7 @@ class _Recorder:
         self.n = n
         self.frames: dict[str, list[np.ndarray]] = {k: [] for k in _ARRAYS}
         self.onset_parts: list[dict[str, np.ndarray]] = []
+        self.wall_parts: list[dict[str, np.ndarray]] = []
         self.removal_times = np.full(n, np.nan)
 
     def sample(self, sim, table: AccumulationTable) -> None:
@@ -236,14 +244,17 @@ class _Recorder:
     def collect_events(self, sim) -> None:
         """Move the engine's onset log and removals into the record (and clear the log)."""
         o = sim.onsets()
-        keep = ~np.asarray(o["partner_is_wall"], bool)
-        self.onset_parts.append({
-            "i": np.asarray(o["particle"], np.int64)[keep],
-            "j": np.asarray(o["partner"], np.int64)[keep],
-            "time": np.asarray(o["time"], float)[keep],
-            "normal_speed": np.asarray(o["normal_speed"], float)[keep],
-            "tangential_speed": np.asarray(o["tangential_speed"], float)[keep],
-        })
+        wall = np.asarray(o["partner_is_wall"], bool)
+        for keep, parts in ((~wall, self.onset_parts), (wall, self.wall_parts)):
+            parts.append({
+                "i": np.asarray(o["particle"], np.int64)[keep],
+                "j": np.asarray(o["partner"], np.int64)[keep],
+                "time": np.asarray(o["time"], float)[keep],
+                "normal_speed": np.asarray(o["normal_speed"], float)[keep],
+                "tangential_speed": np.asarray(o["tangential_speed"], float)[keep],
+            })
+        point = np.asarray(o["partner_position"], float).reshape(-1, 3)[wall]
+        self.wall_parts[-1]["point"] = point
         sim.clear_records()
         times, index = sim.removals()
         index = np.asarray(index, np.int64)
@@ -253,11 +264,30 @@ class _Recorder:
     def stacked(self) -> dict[str, np.ndarray]:
         return {k: np.stack(v) if v else np.zeros(0) for k, v in self.frames.items()}
 
-    def raw_onsets(self) -> dict[str, np.ndarray]:
-        names = ("i", "j", "time", "normal_speed", "tangential_speed")
-        if not self.onset_parts:
-            return {k: np.zeros(0, np.int64 if k in "ij" else float) for k in names}
-        return {k: np.concatenate([p[k] for p in self.onset_parts]) for k in names}
+    def raw_onsets(self, walls: bool = False) -> dict[str, np.ndarray]:
+        names: tuple[str, ...] = ("i", "j", "time", "normal_speed", "tangential_speed")
+        parts = self.wall_parts if walls else self.onset_parts
+        if walls:
+            names += ("point",)
+        if not parts:
+            empty = {k: np.zeros(0, np.int64 if k in "ij" else float) for k in names}
+            if walls:
+                empty["point"] = np.zeros((0, 3))
+            return empty
+        return {k: np.concatenate([p[k] for p in parts]) for k in names}
+
+    def wall_onset_table(self, times: np.ndarray, coordination: np.ndarray) -> np.ndarray:
+        raw = self.raw_onsets(walls=True)
+        table = np.zeros(len(raw["time"]), WALL_ONSET_DTYPE)
+        table["i"], table["wall"], table["time"] = raw["i"], raw["j"], raw["time"]
+        table["normal_speed"] = raw["normal_speed"]
+        table["tangential_speed"] = raw["tangential_speed"]
+        table["impact_angle"] = np.arctan2(raw["tangential_speed"], raw["normal_speed"])
+        table["x"], table["y"], table["z"] = raw["point"].T if len(table) else ([], [], [])
+        if len(table):
+            zi = coordination[_nearest_frame(times, raw["time"]), raw["i"]]
+            table["coordination_i"] = np.where(np.isfinite(zi), zi, -1).astype(np.int64)
+        return table[np.argsort(table["time"], kind="stable")]
 
     def onset_table(self, times: np.ndarray, coordination: np.ndarray) -> np.ndarray:
         raw = self.raw_onsets()
@@ -276,6 +306,7 @@ class _Recorder:
     def save_partial(self, path: Path) -> None:
         arrays: dict[str, Any] = {f"frame_{k}": v for k, v in self.stacked().items()}
         arrays.update({f"onset_{k}": v for k, v in self.raw_onsets().items()})
+        arrays.update({f"wall_onset_{k}": v for k, v in self.raw_onsets(walls=True).items()})
         arrays["removal_times"] = self.removal_times
         with atomic_path(path, suffix=".npz") as tmp:
             with open(tmp, "wb") as fh:
@@ -287,6 +318,10 @@ class _Recorder:
                 self.frames[k] = list(data[f"frame_{k}"])
             self.onset_parts = [{k: data[f"onset_{k}"] for k in
                                  ("i", "j", "time", "normal_speed", "tangential_speed")}]
+            if "wall_onset_time" in data.files:
+                self.wall_parts = [{k: data[f"wall_onset_{k}"] for k in
+                                    ("i", "j", "time", "normal_speed", "tangential_speed",
+                                     "point")}]
             self.removal_times = np.array(data["removal_times"], float)
 
 
@@ -435,7 +470,9 @@ def run_table(table: AccumulationTable, duration: float, sample_interval: float 
         radii=np.asarray(scene.radii, float),
         removal_times=rec.removal_times,
         onsets=rec.onset_table(frames["times"], frames["coordination"]),
+        wall_onsets=rec.wall_onset_table(frames["times"], frames["coordination"]),
         info={"model": model, "dt": float(sim.dt), "effects": list(scene.effects),
+              "wall_names": [str(w["name"]) for w in scene.walls],
               "steps": int(sim.steps), "threads": int(threads),
               "sample_interval": float(sample_interval), "duration": float(duration),
               "wall_time_s": wall_before + _time.perf_counter() - start},
