@@ -18,7 +18,7 @@ use crate::geometry::Vec3;
 
 const MAGIC: &[u8; 8] = b"DEMFEMCK";
 /// Version of the checkpoint format.
-pub const CHECKPOINT_VERSION: u32 = 1;
+pub const CHECKPOINT_VERSION: u32 = 2;
 
 struct Writer(Vec<u8>);
 impl Writer {
@@ -161,6 +161,7 @@ impl Simulation {
         w.u64(self.wall_slots.len() as u64);
         for s in &self.wall_slots {
             w.u32(s.wall);
+            w.u32(s.triangle);
             w.u8(s.active as u8);
             w.vec3(s.history);
         }
@@ -261,7 +262,13 @@ impl Simulation {
             pair_active.push(active);
         }
         let pair_onset = vec![false; n_pairs];
-        let stride = r.count(self.walls.len().max(1), "wall stride")?.max(1);
+        // a mesh wall has a slot per triangle within reach
+        let max_stride = self
+            .walls
+            .iter()
+            .map(|w| w.mesh().map_or(1, |m| m.triangles().len()))
+            .sum::<usize>();
+        let stride = r.count(max_stride.max(1), "wall stride")?.max(1);
         let n_slots = r.count(n * stride, "wall slot")?;
         if n_slots != n * stride {
             return Err(bad("corrupt checkpoint: wall slot count".into()));
@@ -272,10 +279,22 @@ impl Simulation {
             if wall != u32::MAX && wall as usize >= self.walls.len() {
                 return Err(bad(format!("corrupt checkpoint: wall index {wall}")));
             }
+            let triangle = r.u32()?;
+            if wall != u32::MAX {
+                let n_triangles = self.walls[wall as usize]
+                    .mesh()
+                    .map_or(1, |m| m.triangles().len());
+                if triangle as usize >= n_triangles {
+                    return Err(bad(format!(
+                        "corrupt checkpoint: triangle index {triangle}"
+                    )));
+                }
+            }
             let active = r.u8()? != 0;
             let history = r.vec3()?;
             slots.push(WallContact {
                 wall,
+                triangle,
                 active,
                 history,
                 ..Default::default()

@@ -14,6 +14,10 @@
 //!   cross-checked against parry3d's triangle projection in the tests.
 //! * [`WallShape::Cuboid`]: a solid axis-aligned box, closest point through parry3d-f64's
 //!   `Cuboid` point projection (faces, edges and corners handled by parry).
+//! * [`WallShape::Mesh`]: a triangle mesh (walls from CAD), two-sided, its triangles found
+//!   through the BVH of parry3d-f64's `TriMesh`; each (particle, triangle) within reach is a
+//!   wall slot of its own, and the rule of module [`mesh`] counts each touching face, edge
+//!   and vertex once.
 //!
 //! All lengths in metres, velocities in m/s, times in seconds.
 
@@ -21,6 +25,9 @@ use parry3d_f64::query::PointQuery;
 use parry3d_f64::shape::Cuboid;
 
 use crate::error::{check_non_negative, check_positive, DemfemError, Result};
+
+pub mod mesh;
+pub use mesh::{MeshFeature, MeshWall};
 
 /// Three-component vector (x, y, z) used throughout the DEM (glam `DVec3` as re-exported by
 /// parry3d-f64).
@@ -66,6 +73,8 @@ pub enum WallShape {
         /// The parry shape used for the projection.
         shape: Cuboid,
     },
+    /// Triangle mesh, two-sided (see [`MeshWall`]); shared, so cloning a scene is cheap.
+    Mesh(std::sync::Arc<MeshWall>),
 }
 
 impl WallShape {
@@ -234,6 +243,7 @@ impl WallShape {
                     None
                 }
             }
+            WallShape::Mesh(mesh) => mesh.closest(p),
         }
     }
 }
@@ -404,6 +414,34 @@ impl Wall {
         self.shape
             .closest(p - offset)
             .map(|(q, n, d)| (q + offset, n, d))
+    }
+
+    /// The triangle mesh of a [`WallShape::Mesh`] wall.
+    #[inline(always)]
+    pub fn mesh(&self) -> Option<&MeshWall> {
+        match &self.shape {
+            WallShape::Mesh(m) => Some(m),
+            _ => None,
+        }
+    }
+
+    /// What a contact slot of this wall sees of a sphere of radius `r` at `p`, the wall at
+    /// displacement `offset`: closest point, unit normal (wall → p) and distance, or `None`
+    /// out of contact. `triangle` is the slot's triangle on a mesh wall (ignored otherwise,
+    /// where the whole wall is one slot). For the initial-overlap check and the records.
+    pub fn slot_closest_at(
+        &self,
+        triangle: u32,
+        p: Vec3,
+        offset: Vec3,
+        r: f64,
+    ) -> Option<(Vec3, Vec3, f64)> {
+        match &self.shape {
+            WallShape::Mesh(m) => m
+                .contact(triangle, p - offset, r)
+                .map(|(q, n, d)| (q + offset, n, d)),
+            _ => self.closest_at(p, offset),
+        }
     }
 }
 

@@ -154,6 +154,12 @@ fn prepare_wall(k: usize, wall: &RigidWall) -> Result<PreparedWall> {
                 detail: "rigid scenes take plane and polygon walls, not cuboids".into(),
             })
         }
+        WallShape::Mesh(_) => {
+            return Err(DemfemError::ShapeMismatch {
+                field: format!("walls[{k}]"),
+                detail: "rigid scenes take plane and polygon walls, not meshes (yet)".into(),
+            })
+        }
     };
     Ok(PreparedWall {
         shape,

@@ -201,9 +201,12 @@ impl Simulation {
                     break;
                 }
                 let ws = self.wall_state[s.wall as usize];
-                if let Some((_, _, d)) =
-                    self.walls[s.wall as usize].closest_at(self.position[i], ws.offset)
-                {
+                if let Some((_, _, d)) = self.walls[s.wall as usize].slot_closest_at(
+                    s.triangle,
+                    self.position[i],
+                    ws.offset,
+                    self.radius[i],
+                ) {
                     let overlap = self.radius[i] - d;
                     if overlap > tolerance * self.radius[i] {
                         return Err(DemfemError::InvalidParameter {

@@ -69,7 +69,8 @@ pub(super) fn wall_touch<const E: u16>(
     } else {
         WallState::default()
     };
-    let Some((point, out_normal, dist)) = wall_hit(wall, x, moving.then_some(ws.offset), r) else {
+    let offset = moving.then_some(ws.offset);
+    let Some((point, out_normal, dist)) = wall_hit(wall, s.triangle, x, offset, r) else {
         end_wall_contact(s);
         return None;
     };
@@ -115,11 +116,13 @@ pub(super) fn wall_velocity<const E: u16>(
 
 /// Closest point, unit normal (wall → x) and distance of a wall slot when the sphere of
 /// radius r touches it. Half-spaces (the belt) by hand: one dot product, nothing else when
-/// out of reach.
+/// out of reach. On a mesh wall, the slot's `triangle` under the rule of
+/// [`crate::geometry::mesh`] (each touching face, edge and vertex counted once).
 /// `offset` is `None` for walls that do not move (no `moving_walls` effect).
 #[inline(always)]
 pub(super) fn wall_hit(
     wall: &Wall,
+    triangle: u32,
     x: Vec3,
     offset: Option<Vec3>,
     r: f64,
@@ -134,6 +137,11 @@ pub(super) fn wall_hit(
             } else {
                 None
             }
+        }
+        WallShape::Mesh(mesh) => {
+            let p = offset.map_or(x, |o| x - o);
+            let (q, n, d) = mesh.contact(triangle, p, r)?;
+            Some((offset.map_or(q, |o| q + o), n, d))
         }
         _ => match wall.closest_at(x, offset.unwrap_or(Vec3::ZERO)) {
             Some(h) if h.2 < r => Some(h),

@@ -295,7 +295,9 @@ unsafe fn plane_scatter<const E: u16, const R: bool>(
                 let wall = &c.walls[s.wall as usize];
                 let offset = moving.then(|| c.wall_state[s.wall as usize].offset);
                 let x = c.shared.position[first + i];
-                if let Some((point, _, _)) = wall_hit(wall, x, offset, c.shared.radius[first + i]) {
+                if let Some((point, _, _)) =
+                    wall_hit(wall, s.triangle, x, offset, c.shared.radius[first + i])
+                {
                     d.point = point;
                 }
             }
