@@ -379,3 +379,75 @@ fn mesh_checkpoint_round_trip_is_bitwise() {
     assert_eq!(a.positions()[0], b.positions()[0]);
     assert_eq!(a.velocities()[0], b.velocities()[0]);
 }
+
+/// Two belts in one floor mesh (per-triangle surface velocities, 0.1 m/s for x < 0 and
+/// 0.3 m/s for x > 0, meeting along x = 0): a sphere set down at rest on each ends up rolling
+/// without slip at 2/7 of its own belt's speed (rigid-body closed form for a sphere on a
+/// belt), within 0.1 %.
+#[test]
+fn two_belts_in_one_mesh_drive_each_sphere_at_two_sevenths_of_its_speed() {
+    let h = 0.1;
+    let n = 20;
+    let WallShape::Mesh(grid) = floor_mesh(n, h, 0.0) else {
+        unreachable!()
+    };
+    let speeds: Vec<Vec3> = grid
+        .triangles()
+        .iter()
+        .map(|t| {
+            let cx: f64 = t
+                .iter()
+                .map(|&k| grid.vertices()[k as usize].x)
+                .sum::<f64>()
+                / 3.0;
+            Vec3::new(if cx < 0.0 { 0.1 } else { 0.3 }, 0.0, 0.0)
+        })
+        .collect();
+    let belts = MeshWall::with_triangle_velocities(
+        grid.vertices().to_vec(),
+        grid.triangles().to_vec(),
+        speeds,
+    )
+    .unwrap();
+    let p = ParticleInit::at_rest(
+        vec![
+            Vec3::new(-0.06, 0.0, R - 1e-6),
+            Vec3::new(0.03, 0.0, R - 1e-6),
+        ],
+        vec![R, R],
+    );
+    let mats = vec![material(E_GLASS, NU, RHO, 0.3, 0.3), rigid(NU, 0.3, 0.3)];
+    let effects = EffectSet::of(&[
+        Effect::Gravity,
+        Effect::Damping,
+        Effect::Friction,
+        Effect::Rotation,
+        Effect::Belt,
+    ]);
+    let mut s = Scene::new(
+        p,
+        mats,
+        vec![Wall::fixed(WallShape::Mesh(belts), 1)],
+        effects,
+    );
+    s.gravity = Vec3::new(0.0, 0.0, -9.81);
+    let mut sim = Simulation::new(&s).unwrap();
+    sim.run_until(0.15).unwrap();
+    for (k, belt) in [0.1, 0.3].into_iter().enumerate() {
+        let v = sim.velocities()[k].x;
+        println!(
+            "sphere on the {belt} m/s belt: {v:.6} m/s = {:.5} x belt (2/7 = {:.5})",
+            v / belt,
+            2.0 / 7.0
+        );
+        assert!(
+            (v / belt / (2.0 / 7.0) - 1.0).abs() < 5e-3,
+            "belt {belt}: {v}"
+        );
+    }
+    assert!(
+        sim.positions()[0].x < -0.04,
+        "left its belt: {:?}",
+        sim.positions()[0]
+    );
+}

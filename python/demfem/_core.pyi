@@ -67,7 +67,10 @@ class DemSimulation:
     positions (N, 3) m; radii (N,) m; materials: list of dicts with young_modulus (Pa),
     poisson_ratio, density (kg/m^3), friction, restitution, rolling_friction, shell_stiffness
     (N/m); walls: list of dicts with type 'plane' (point, normal), 'polygon' (vertices),
-    'strip' (x0, y0, x1, y1, z_bottom, z_top) or 'cuboid' (center, half_extents), plus material,
+    'strip' (x0, y0, x1, y1, z_bottom, z_top), 'cuboid' (center, half_extents) or 'mesh'
+    (vertices (N, 3) m, triangles (M, 3) vertex indices, closed: bool, True to refuse an
+    open mesh, triangle_velocities (M, 3) m/s: each triangle's own surface velocity, belts;
+    two-sided, each touching face, edge and vertex counted once), plus material,
     surface_velocity (m/s) and motion ({'type': 'constant', 'velocity'} or
     {'type': 'harmonic', 'direction', 'amplitude' (m), 'period' (s), 'phase' (rad)});
     effects: names from gravity, belt, moving_walls, friction, rotation, damping,

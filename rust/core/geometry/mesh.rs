@@ -65,6 +65,9 @@ pub struct MeshWall {
     edge_triangles: Vec<u32>,
     vertex_start: Vec<u32>,
     vertex_triangles: Vec<u32>,
+    /// Surface velocity of each triangle, m/s (belts: one mesh floor whose regions move at
+    /// their own speeds), or empty: the wall's own surface velocity everywhere.
+    triangle_velocities: Vec<Vec3>,
     fingerprint: u64,
 }
 
@@ -73,6 +76,7 @@ impl std::fmt::Debug for MeshWall {
         f.debug_struct("MeshWall")
             .field("vertices", &self.vertices.len())
             .field("triangles", &self.triangles.len())
+            .field("triangle_velocities", &self.triangle_velocities.len())
             .field("fingerprint", &self.fingerprint)
             .finish()
     }
@@ -201,8 +205,54 @@ impl MeshWall {
             edge_triangles,
             vertex_start,
             vertex_triangles,
+            triangle_velocities: Vec::new(),
             fingerprint,
         }))
+    }
+
+    /// A mesh whose triangles each carry their own surface velocity (m/s, one per triangle):
+    /// a floor of several belts meeting edge to edge, so that the contact rule counts a
+    /// sphere on the seam between two belts once. At a seam the lower-numbered triangle's
+    /// belt drives the sphere.
+    pub fn with_triangle_velocities(
+        vertices: Vec<Vec3>,
+        triangles: Vec<[u32; 3]>,
+        velocities: Vec<Vec3>,
+    ) -> Result<Arc<Self>> {
+        if velocities.len() != triangles.len() {
+            return Err(DemfemError::ShapeMismatch {
+                field: "mesh.triangle_velocities".into(),
+                detail: format!(
+                    "expected one per triangle ({}), got {}",
+                    triangles.len(),
+                    velocities.len()
+                ),
+            });
+        }
+        for (t, v) in velocities.iter().enumerate() {
+            if !v.is_finite() {
+                return Err(DemfemError::InvalidParameter {
+                    field: format!("mesh.triangle_velocities[{t}]"),
+                    value: format!("{v:?}"),
+                    allowed: "finite components, m/s".into(),
+                });
+            }
+        }
+        let mut mesh = Arc::unwrap_or_clone(Self::new(vertices, triangles)?);
+        for v in &velocities {
+            for c in [v.x, v.y, v.z] {
+                mesh.fingerprint ^= c.to_bits();
+                mesh.fingerprint = mesh.fingerprint.wrapping_mul(0x100000001b3);
+            }
+        }
+        mesh.triangle_velocities = velocities;
+        Ok(Arc::new(mesh))
+    }
+
+    /// The surface velocity of triangle `t`, m/s, if the triangles carry their own.
+    #[inline(always)]
+    pub fn triangle_velocity(&self, t: u32) -> Option<Vec3> {
+        self.triangle_velocities.get(t as usize).copied()
     }
 
     /// The vertices, m.

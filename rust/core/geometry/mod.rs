@@ -416,6 +416,18 @@ impl Wall {
             .map(|(q, n, d)| (q + offset, n, d))
     }
 
+    /// Surface velocity at a contact with `triangle` (of a mesh wall whose triangles carry
+    /// their own, [`MeshWall::triangle_velocity`]; else the wall's), m/s.
+    #[inline(always)]
+    pub fn surface_velocity_at(&self, triangle: u32) -> Vec3 {
+        match &self.shape {
+            WallShape::Mesh(m) => m
+                .triangle_velocity(triangle)
+                .unwrap_or(self.surface_velocity),
+            _ => self.surface_velocity,
+        }
+    }
+
     /// The triangle mesh of a [`WallShape::Mesh`] wall.
     #[inline(always)]
     pub fn mesh(&self) -> Option<&MeshWall> {

@@ -80,7 +80,7 @@ pub(super) fn wall_touch<const E: u16>(
         n,
         overlap: r - dist,
         arm: dist.max(0.0),
-        wall_v: wall_velocity::<E>(wall, ws, n, c.shared.effects),
+        wall_v: wall_velocity::<E>(wall, s.triangle, ws, n, c.shared.effects),
     })
 }
 
@@ -96,10 +96,11 @@ pub(super) fn end_wall_contact(s: &mut WallContact) {
 
 /// Velocity of the wall's material at a contact with normal `n` (particle towards wall),
 /// m/s: the wall's motion (`ws`, zero without `moving_walls`) plus the belt's surface velocity
-/// tangent to the contact.
+/// tangent to the contact (on a mesh wall with belts, that of the slot's `triangle`).
 #[inline(always)]
 pub(super) fn wall_velocity<const E: u16>(
     wall: &Wall,
+    triangle: u32,
     ws: WallState,
     n: Vec3,
     effects: EffectSet,
@@ -107,7 +108,7 @@ pub(super) fn wall_velocity<const E: u16>(
     let moving = on::<E>(effects, Effect::MovingWalls);
     let mut wall_v = ws.velocity;
     if on::<E>(effects, Effect::Belt) {
-        let s_v = wall.surface_velocity;
+        let s_v = wall.surface_velocity_at(triangle);
         let belt = s_v - s_v.dot(n) * n;
         wall_v = if moving { wall_v + belt } else { belt };
     }
