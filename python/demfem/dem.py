@@ -29,6 +29,7 @@ __all__ = [
     "polygon",
     "strip",
     "cuboid",
+    "mesh",
     "harmonic",
     "constant_velocity",
     "run",
@@ -97,6 +98,22 @@ def cuboid(center: Vector, half_extents: Vector, *, material: int = 0,
            motion: Optional[dict[str, Any]] = None) -> dict[str, Any]:
     """Solid axis-aligned box: centre and half extents (m)."""
     return _wall("cuboid", material, None, motion, center=tuple(center), half_extents=tuple(half_extents))
+
+
+def mesh(vertices: Any, triangles: Any, *, material: int = 0, closed: bool = False,
+         surface_velocity: Optional[Vector] = None, triangle_velocities: Any = None,
+         motion: Optional[dict[str, Any]] = None) -> dict[str, Any]:
+    """Triangle-mesh wall (two-sided): ``vertices`` (N, 3) m, ``triangles`` (M, 3) vertex
+    indices; ``closed`` refuses an open surface; ``triangle_velocities`` (M, 3) m/s gives
+    each triangle its own surface velocity (several belts in one floor)."""
+    import numpy as np
+
+    w = _wall("mesh", material, surface_velocity, motion,
+              vertices=np.ascontiguousarray(vertices, dtype=float),
+              triangles=np.ascontiguousarray(triangles, dtype=np.int64), closed=bool(closed))
+    if triangle_velocities is not None:
+        w["triangle_velocities"] = np.ascontiguousarray(triangle_velocities, dtype=float)
+    return w
 
 
 def harmonic(direction: Vector, amplitude: float, period: float, phase: float = 0.0) -> dict[str, Any]:
@@ -327,9 +344,13 @@ def scene_walls(scene: Any, material_index: Callable[[str], int]) -> list[dict[s
         elif w["kind"] == "polygon":
             walls.append(polygon([list(map(float, v)) for v in np.asarray(w["vertices"])],
                                  material=mat, surface_velocity=sv, motion=mo))
+        elif w["kind"] == "mesh":
+            walls.append(mesh(w["vertices"], w["triangles"], material=mat,
+                              closed=bool(w.get("closed", False)), surface_velocity=sv,
+                              triangle_velocities=w.get("triangle_velocities"), motion=mo))
         else:
             raise InvalidParameterError(f"invalid wall {w.get('name')!r} kind = {w['kind']!r}: "
-                                        "must be 'plane' or 'polygon'")
+                                        "must be 'plane', 'polygon' or 'mesh'")
     return walls
 
 
