@@ -198,7 +198,7 @@ def test_continuous_infeed_runs_from_the_command_line(tmp_path, capsys):
     assert main(["run", str(path), "--out", str(out)]) == 0
     s = json.loads((out / "summary.json").read_text())
     assert s["inserted"] == 15  # t = 0, 0.1, ..., 1.4 s
-    assert s["backlog_at_end"] <= 1
+    assert s["backlog_at_end"] == 0
     assert s["lost"] == 0
     assert s["exited"] > 0
     residence = np.loadtxt(out / "exits.csv", delimiter=",", skiprows=1, ndmin=2)[:, 1]
@@ -243,18 +243,29 @@ def test_example_table_reaches_a_steady_state(tmp_path):
 @pytest.mark.slow
 def test_default_table_as_a_mesh_agrees_with_the_analytic_walls():
     """The default table (840 spheres, 45 GPa) with its fixed walls as a 10 000-triangle mesh
-    and with its analytic walls, 0.3 s: the statistics agree (not bitwise: the mesh ends at
-    the walls' height where the planes are infinite, and rounding differs): mean speed and
-    kinetic energy within 5 %, mean coordination within 3 %, wall contacts within 5 %."""
+    against its analytic walls, 0.5 s, statistics averaged over 0.1-0.5 s (mean speed,
+    kinetic energy, mean coordination, wall contacts). Not bitwise: the packing is chaotic,
+    so a chaos control (the analytic table with its start positions moved by 1e-9 m) sets
+    the scale: the mesh run must differ from the analytic one by at most twice what the
+    control does, or 3 %. Measured (this machine): coordination 1.015 analytic, 0.943
+    control, 1.082 mesh; mean speed 0.0508, 0.0519, 0.0500 m/s; wall contacts 772, 781,
+    778."""
+    import dataclasses
+
     from demfem.scenes import AccumulationTable
     from demfem.scenes.mesh_table import table_walls_as_mesh
 
     table = AccumulationTable()
+    analytic = table.build()
+    moved = analytic.positions + np.random.default_rng(1).normal(0.0, 1e-9,
+                                                                 analytic.positions.shape)
+    control = dataclasses.replace(analytic, positions=moved)
     stats = {}
-    for name, d in (("analytic", table.build()), ("mesh", table_walls_as_mesh(table))):
+    for name, d in (("analytic", analytic), ("control", control),
+                    ("mesh", table_walls_as_mesh(table))):
         sim = dem.from_scene(d, threads=2)
         rows = []
-        for _ in range(6):
+        for _ in range(10):
             dem.run(sim, sim.time + 0.05)
             alive = np.asarray(sim.alive(), bool)
             speed = np.linalg.norm(np.asarray(sim.velocities())[alive], axis=1)
@@ -262,10 +273,9 @@ def test_default_table_as_a_mesh_agrees_with_the_analytic_walls():
                          np.asarray(sim.coordination())[alive].mean(),
                          np.asarray(sim.wall_contacts())[alive].sum()])
         stats[name] = np.mean(rows[2:], axis=0)
-    a, m = stats["analytic"], stats["mesh"]
-    print("analytic", a, "mesh", m)
-    assert m[0] == pytest.approx(a[0], rel=0.05)
-    assert m[1] == pytest.approx(a[1], rel=0.05)
-    assert m[2] == pytest.approx(a[2], rel=0.03)
-    assert m[3] == pytest.approx(a[3], rel=0.05)
-    assert math.isfinite(m[0])
+    a, c, m = stats["analytic"], stats["control"], stats["mesh"]
+    print("analytic", a, "control", c, "mesh", m)
+    for k, what in enumerate(("mean speed", "kinetic energy", "coordination", "wall contacts")):
+        allowed = max(2.0 * abs(c[k] - a[k]), 0.03 * abs(a[k]))
+        assert abs(m[k] - a[k]) <= allowed, (what, a[k], c[k], m[k])
+        assert math.isfinite(m[k])

@@ -134,7 +134,8 @@ def run_mesh_table(table: MeshTable, out: str | Path, *, duration: Optional[floa
             say(f"  t = {sim.time:.2f} / {duration:g} s: on the table {int(alive.sum())}, "
                 f"in {n_inserted}, out {len(exits)}, lost {n_lost}, backlog {backlog}")
     wall_time = _time.perf_counter() - wall_start
-    final_backlog = int(math.floor(sim.time * rate + 1e-9)) + 1 - n_inserted
+    # cartridges due strictly before the end (t = k / rate < t_end) and not placed
+    final_backlog = int(math.ceil(duration * rate - 1e-9)) - n_inserted
     population = np.divide(win["population"], np.maximum(win["samples"], 1))
     summary = {
         **table.summary_fields(),
