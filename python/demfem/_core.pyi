@@ -71,8 +71,9 @@ class DemSimulation:
     (vertices (N, 3) m, triangles (M, 3) vertex indices, closed: bool, True to refuse an
     open mesh, triangle_velocities (M, 3) m/s: each triangle's own surface velocity, belts;
     two-sided, each touching face, edge and vertex counted once), plus material,
-    surface_velocity (m/s) and motion ({'type': 'constant', 'velocity'} or
-    {'type': 'harmonic', 'direction', 'amplitude' (m), 'period' (s), 'phase' (rad)});
+    surface_velocity (m/s) and motion ({'type': 'constant', 'velocity'},
+    {'type': 'harmonic', 'direction', 'amplitude' (m), 'period' (s), 'phase' (rad)} or
+    {'type': 'rotation', 'axis_point' (m), 'axis', 'angular_velocity' (rad/s)}, not for planes);
     effects: names from gravity, belt, moving_walls, friction, rotation, damping,
     rolling_resistance, planar. gravity (m/s^2) defaults to (0, 0, -9.81). dt (s) defaults
     to dt_safety x the stable limit; a larger one

@@ -32,6 +32,7 @@ __all__ = [
     "mesh",
     "harmonic",
     "constant_velocity",
+    "rotation",
     "run",
     "from_scene",
     "refeed_removed",
@@ -119,6 +120,13 @@ def mesh(vertices: Any, triangles: Any, *, material: int = 0, closed: bool = Fal
 def harmonic(direction: Vector, amplitude: float, period: float, phase: float = 0.0) -> dict[str, Any]:
     """Wall motion x(t) = x0 + A sin(2π t / T + φ) along ``direction``; A in m, T in s."""
     return {"type": "harmonic", "direction": tuple(direction), "amplitude": amplitude, "period": period, "phase": phase}
+
+
+def rotation(axis_point: Vector, axis: Vector, angular_velocity: float) -> dict[str, Any]:
+    """Wall motion: rotation about the axis through ``axis_point`` (m) along ``axis``
+    (right-handed) at ``angular_velocity`` rad/s (a star wheel); not for planes."""
+    return {"type": "rotation", "axis_point": tuple(axis_point), "axis": tuple(axis),
+            "angular_velocity": angular_velocity}
 
 
 def constant_velocity(velocity: Vector) -> dict[str, Any]:
@@ -332,9 +340,13 @@ def scene_walls(scene: Any, material_index: Callable[[str], int]) -> list[dict[s
                           float(motion["period"]), float(motion.get("phase", 0.0)))
         elif kind == "constant":
             mo = constant_velocity(tuple(np.asarray(motion["velocity"], float)))
+        elif kind == "rotation":
+            mo = rotation(tuple(np.asarray(motion["axis_point"], float)),
+                          tuple(np.asarray(motion["axis"], float)),
+                          float(motion["angular_velocity"]))
         else:
             raise InvalidParameterError(f"invalid wall {w.get('name')!r} motion kind = {kind!r}: "
-                                        "must be 'fixed', 'harmonic' or 'constant'")
+                                        "must be 'fixed', 'harmonic', 'constant' or 'rotation'")
         sv = w.get("surface_velocity")
         sv = None if sv is None or not np.any(np.asarray(sv)) else tuple(np.asarray(sv, float))
         mat = material_index(w.get("material", scene.particle_material))

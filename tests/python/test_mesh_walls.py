@@ -10,7 +10,7 @@ import pytest
 
 from demfem import dem
 from demfem.cli import main
-from demfem.errors import DemfemIOError, InvalidParameterError
+from demfem.errors import DemfemError, DemfemIOError, InvalidParameterError
 from demfem.io.stl import check_mesh, open_edge_count, read_mesh, read_stl, weld_vertices, write_stl
 from demfem.scenes.mesh_table import MeshTable, extrude_polyline
 
@@ -121,6 +121,30 @@ def test_engine_refuses_a_bad_mesh_naming_the_wall():
                           [dem.mesh(v, t, material=1, closed=True)], [], gravity=(0, 0, 0))
 
 
+def test_rotating_mesh_arm_strikes_a_sphere_at_twice_its_speed():
+    """A star-wheel arm (a vertical plate mesh rotating about z at 2 rad/s) strikes a sphere
+    at rest 0.1 m from the axis: frictionless and elastic against a prescribed (infinitely
+    massive) wall, it leaves at 2 ω ρ = 0.4 m/s along the arm's normal (+y)."""
+    x = np.linspace(0.02, 0.2, 7)
+    v = np.array([[xk, 0.0, z] for xk in x for z in (0.0, 0.03)])
+    t = np.array([tri for k in range(6) for tri in ([2 * k, 2 * k + 2, 2 * k + 3],
+                                                    [2 * k, 2 * k + 3, 2 * k + 1])])
+    arm = dem.mesh(v, t, material=1, motion=dem.rotation((0, 0, 0), (0, 0, 1), 2.0))
+    sim = dem.DemSimulation(np.array([[0.1, R + 2e-5, 0.015]]), np.array([R]),
+                            [dem.material(45e9, 0.22, 2230.0), RIGID0], [arm],
+                            ["moving_walls"], gravity=(0, 0, 0), expected_max_speed=0.4)
+    sim.run_until(0.01)
+    u = sim.velocities()[0]
+    assert np.linalg.norm(u) == pytest.approx(0.4, rel=2e-3)
+    assert u[1] / np.linalg.norm(u) == pytest.approx(1.0, abs=2e-3)
+    with pytest.raises(DemfemError, match="plane cannot rotate"):
+        dem.DemSimulation(np.array([[0.1, 0.1, 0.1]]), np.array([R]),
+                          [dem.material(45e9, 0.22, 2230.0), RIGID0],
+                          [dem.plane((0, 0, 0), (0, 0, 1), material=1,
+                                     motion=dem.rotation((0, 0, 0), (0, 0, 1), 1.0))],
+                          ["moving_walls"], gravity=(0, 0, 0))
+
+
 # ---- the scene file -----------------------------------------------------------------------
 
 def small_table(tmp_path: Path, **replace: str) -> Path:
@@ -165,6 +189,10 @@ def test_scene_file_errors_name_the_file_the_field_and_the_range(tmp_path):
                           r"1.06e\+04 cartridges per minute"),
         "bad scale": ({"meshes": '[[meshes]]\nfile = "walls.stl"\nscale = -1\n'},
                       InvalidParameterError, r"meshes\[0\].*scale"),
+        "rotation without axis": ({"meshes": '[[meshes]]\nfile = "walls.stl"\nscale = 0.001\n'
+                                   'motion = { kind = "rotation", axis = [0, 0, 0], '
+                                   "axis_point = [0, 0, 0], angular_velocity = 1.0 }\n"},
+                                  InvalidParameterError, r"meshes\[0\].*motion.axis"),
         "unknown key": ({"particles": "[particles]\nradiuss = 0.01\n"}, InvalidParameterError,
                         "unknown key 'radiuss'"),
         "unknown material": ({"meshes": '[[meshes]]\nfile = "walls.stl"\nscale = 0.001\n'

@@ -93,8 +93,19 @@ def _motion(value: Any, where: str) -> dict[str, Any]:
         _keys(value, ("kind", "velocity"), where)
         return {"kind": "constant",
                 "velocity": _vec(f"{where}.velocity", value.get("velocity"), 3)}
+    if kind == "rotation":
+        _keys(value, ("kind", "axis_point", "axis", "angular_velocity"), where)
+        axis = _vec(f"{where}.axis", value.get("axis", (0.0, 0.0, 1.0)), 3)
+        if not np.linalg.norm(axis) > 0:
+            raise InvalidParameterError(f"invalid {where}.axis = {axis.tolist()}: must be a "
+                                        "non-zero vector")
+        return {"kind": "rotation",
+                "axis_point": _vec(f"{where}.axis_point", value.get("axis_point"), 3),
+                "axis": axis / np.linalg.norm(axis),
+                "angular_velocity": check_range(f"{where}.angular_velocity (rad/s)",
+                                                value.get("angular_velocity"))}
     raise InvalidParameterError(f"invalid {where}.kind = {kind!r}: must be 'fixed', "
-                                "'harmonic' or 'constant'")
+                                "'harmonic', 'constant' or 'rotation'")
 
 
 @dataclass(frozen=True, eq=False)

@@ -245,11 +245,17 @@ pub(crate) fn parse_wall(d: &Bound<'_, PyDict>, k: usize) -> PyResult<Wall> {
                     get_f64(&m, "phase", Some(0.0), &mw)?,
                 )
                 .map_err(PyDemfemError::from)?,
+                "rotation" => WallMotion::rotation(
+                    get_vec3(&m, "axis_point", None, &mw)?,
+                    get_vec3(&m, "axis", None, &mw)?,
+                    get_f64(&m, "angular_velocity", None, &mw)?,
+                )
+                .map_err(PyDemfemError::from)?,
                 other => {
                     return Err(invalid(
                         &format!("{mw}.type"),
                         other,
-                        "'fixed', 'constant' or 'harmonic'",
+                        "'fixed', 'constant', 'harmonic' or 'rotation'",
                     ))
                 }
             }

@@ -150,6 +150,9 @@ impl Simulation {
         for v in &self.reference_wall_offset {
             w.vec3(*v);
         }
+        for a in &self.reference_wall_angle {
+            w.f64(*a);
+        }
         w.u64(self.pairs.len() as u64);
         for (p, &active) in self.pairs.iter().zip(&self.pair_active) {
             w.u32(p.i);
@@ -242,6 +245,10 @@ impl Simulation {
         for _ in 0..self.walls.len() {
             wall_ref.push(r.vec3()?);
         }
+        let mut wall_angle = Vec::with_capacity(self.walls.len());
+        for _ in 0..self.walls.len() {
+            wall_angle.push(r.f64()?);
+        }
         let n_pairs = r.count(data.len() / 33 + 1, "pair")?;
         let mut pairs = Vec::with_capacity(n_pairs);
         let mut pair_active = Vec::with_capacity(n_pairs);
@@ -313,6 +320,7 @@ impl Simulation {
         self.reference_position = reference;
         self.alive = alive;
         self.reference_wall_offset = wall_ref;
+        self.reference_wall_angle = wall_angle;
         self.pairs = pairs;
         self.pair_active = pair_active;
         self.pair_onset = pair_onset;

@@ -133,6 +133,14 @@ fn prepare_wall(k: usize, wall: &RigidWall) -> Result<PreparedWall> {
             "finite components",
         ));
     }
+    if let WallMotion::Rotation { .. } = wall.motion {
+        return Err(DemfemError::ShapeMismatch {
+            field: format!("walls[{k}].motion"),
+            detail: "rigid scenes take fixed, constant-velocity and harmonic walls, not \
+                     rotating ones (yet)"
+                .into(),
+        });
+    }
     if let WallMotion::ConstantVelocity { velocity } = wall.motion {
         if !velocity.is_finite() {
             return Err(DemfemError::invalid(

@@ -148,6 +148,8 @@ impl Simulation {
             wall_stride: 1,
             reference_position: p.position.clone(),
             reference_wall_offset: vec![Vec3::ZERO; scene.walls.len()],
+            reference_wall_angle: vec![0.0; scene.walls.len()],
+            wall_reach: scene.walls.iter().map(|w| w.rotation_reach()).collect(),
             needs_rebuild: true,
             active_base: vec![0; n + 1],
             active_len: vec![0; n],

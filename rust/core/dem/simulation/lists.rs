@@ -41,12 +41,17 @@ impl Simulation {
     pub(crate) fn refresh_wall_state(&mut self) {
         let moving = self.effects.has(Effect::MovingWalls);
         for (k, w) in self.walls.iter().enumerate() {
-            let (offset, velocity) = if moving {
-                w.motion.offset_and_velocity(self.time)
+            let (offset, velocity, angle) = if moving {
+                let (o, v) = w.motion.offset_and_velocity(self.time);
+                (o, v, w.motion.angle_at(self.time))
             } else {
-                (Vec3::ZERO, Vec3::ZERO)
+                (Vec3::ZERO, Vec3::ZERO, 0.0)
             };
-            self.wall_state[k] = WallState { offset, velocity };
+            self.wall_state[k] = WallState {
+                offset,
+                velocity,
+                angle,
+            };
         }
     }
 
@@ -371,12 +376,14 @@ impl Simulation {
             if self.alive[i] {
                 let reach = self.radius[i] + self.skin;
                 for (w, wall) in self.walls.iter().enumerate() {
-                    let offset = self.wall_state[w].offset;
+                    let ws = self.wall_state[w];
+                    // the particle in the wall's reference frame
+                    let p = wall.motion.rotate(-ws.angle, self.position[i] - ws.offset);
                     if let Some(mesh) = wall.mesh() {
                         triangles.clear();
-                        mesh.triangles_within(self.position[i] - offset, reach, &mut triangles);
+                        mesh.triangles_within(p, reach, &mut triangles);
                         found.extend(triangles.iter().map(|&t| (w as u32, t)));
-                    } else if let Some((_, _, d)) = wall.closest_at(self.position[i], offset) {
+                    } else if let Some((_, _, d)) = wall.shape.closest(p) {
                         if d < reach {
                             found.push((w as u32, 0));
                         }
@@ -409,6 +416,7 @@ impl Simulation {
         self.reference_position.clone_from(&self.position);
         for (k, ws) in self.wall_state.iter().enumerate() {
             self.reference_wall_offset[k] = ws.offset;
+            self.reference_wall_angle[k] = ws.angle;
         }
         self.refresh_contact_constants();
         self.needs_rebuild = false;

@@ -112,11 +112,13 @@ pub(crate) struct WallDetail {
     pub(super) onset_tangential_speed: f64,
 }
 
-/// Current position offset and velocity of each wall.
+/// Current position offset and velocity of each wall, and its rotation angle (rad; 0 but
+/// for a rotating wall, whose offset and velocity are zero).
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct WallState {
     pub(super) offset: Vec3,
     pub(super) velocity: Vec3,
+    pub(super) angle: f64,
 }
 
 /// Contacts begun (onsets) and ended in one chunk of the pair list at one force evaluation.

@@ -9,7 +9,7 @@ use super::pair::PairCtx;
 use super::state::{WallContact, WallDetail, WallOut, WallState};
 use super::{on, NO_WALL};
 use crate::dem::effects::{Effect, EffectSet};
-use crate::geometry::{Vec3, Wall, WallShape};
+use crate::geometry::{rotate_about, Vec3, Wall, WallMotion, WallShape};
 
 /// Read-only context of the wall kernels (run in the force phase, next to the pairs).
 pub(super) struct WallCtx<'a> {
@@ -69,18 +69,42 @@ pub(super) fn wall_touch<const E: u16>(
     } else {
         WallState::default()
     };
-    let offset = moving.then_some(ws.offset);
-    let Some((point, out_normal, dist)) = wall_hit(wall, s.triangle, x, offset, r) else {
+    let rotation = match wall.motion {
+        WallMotion::Rotation {
+            axis_point,
+            axis,
+            angular_velocity,
+        } if moving => Some((axis_point, axis, angular_velocity)),
+        _ => None,
+    };
+    let hit = match rotation {
+        // in the wall's reference frame, then back
+        Some((_, axis, _)) => wall_hit(wall, s.triangle, wall.motion.rotate(-ws.angle, x), None, r)
+            .map(|(q, n, d)| {
+                (
+                    wall.motion.rotate(ws.angle, q),
+                    rotate_about(axis, ws.angle, n),
+                    d,
+                )
+            }),
+        None => wall_hit(wall, s.triangle, x, moving.then_some(ws.offset), r),
+    };
+    let Some((point, out_normal, dist)) = hit else {
         end_wall_contact(s);
         return None;
     };
     let n = -out_normal; // from the particle towards the wall
+    let mut wall_v = wall_velocity::<E>(wall, s.triangle, ws, n, c.shared.effects);
+    if let Some((axis_point, axis, angular_velocity)) = rotation {
+        // the wall's material point at the contact: ω × (q − c)
+        wall_v += (axis * angular_velocity).cross(point - axis_point);
+    }
     Some(WallTouch {
         point,
         n,
         overlap: r - dist,
         arm: dist.max(0.0),
-        wall_v: wall_velocity::<E>(wall, s.triangle, ws, n, c.shared.effects),
+        wall_v,
     })
 }
 
