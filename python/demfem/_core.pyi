@@ -323,7 +323,8 @@ class RigidSimulation:
     cartridge frame (axis z); shape: {'kind': 'clump', 'centers' (n, 3) m, 'radii' (n,) m,
     'masses' (n,) kg} or {'kind': 'exact', 'z', 'r_in', 'r_out'} (stations, m; mass from the
     material's density); material: dict with young_modulus (Pa), poisson_ratio, density
-    (kg/m^3), friction, restitution; walls: 'plane' or 'polygon' dicts as for DemSimulation
+    (kg/m^3), friction, restitution; walls: 'plane', 'polygon' or 'mesh' (bead clumps
+    only; not rotating) dicts as for DemSimulation
     (surface_velocity, motion); effects: names from gravity, belt, moving_walls, friction,
     rotation, damping. angular_velocities in the world frame (rad/s). dt (s) defaults to the
     stable limit at expected_max_speed (m/s); a larger one raises UnstableTimeStepError.
