@@ -182,6 +182,10 @@ def test_scene_file_errors_name_the_file_the_field_and_the_range(tmp_path):
                                '[0.3, 0.2], [0, 0.2]]\n[[belts]]\nname = "b"\npolygon = '
                                "[[0.2, 0], [0.5, 0], [0.5, 0.2], [0.2, 0.2]]\n"},
                               InvalidParameterError, "belts 'a' and 'b' overlap"),
+        "T-junction": ({"belts": '[[belts]]\nname = "a"\npolygon = [[0, 0], [0.2, 0], '
+                        '[0.2, 0.2], [0, 0.2]]\n[[belts]]\nname = "b"\npolygon = '
+                        "[[0.2, 0.1], [0.5, 0.1], [0.5, 0.2], [0.2, 0.2]]\n"},
+                       InvalidParameterError, "belt 'b' lies inside an edge of belt 'a'"),
         "rate too high": ({"infeed": "[infeed]\nrate = 1e5\nregion = [[0.01, 0.01], "
                            "[0.05, 0.19]]\nvelocity = [0.3, 0]\n"},
                           InvalidParameterError,

@@ -15,8 +15,8 @@ The schema (every field, unit and default) is in ``docs/mesh-tables.md``; in sho
 
 Frame: z up, the floor (the belts) is the plane z = 0; spheres stand on it. The belts are
 one floor mesh whose triangles carry their belt's surface velocity, so a sphere on the seam
-between two belts has one contact, not two; belts must meet edge to edge (or not at all) and
-must not overlap. Spheres off every belt fall and are counted as lost.
+between two belts has one contact, not two; belts must meet edge to edge (or not at all: a
+T-junction is refused) and must not overlap. Spheres off every belt fall and are counted as lost.
 
 :meth:`MeshTable.from_toml` validates everything it reads, with errors naming the file, the
 field and the allowed range; :meth:`MeshTable.description` builds the engine-neutral
@@ -38,7 +38,8 @@ from demfem.errors import InvalidParameterError, check_count, check_positive, ch
 from demfem.materials import PAPER_GLASS
 
 __all__ = ["MeshTable", "MeshSpec", "Belt", "Infeed", "SCENE_NAME", "belt_floor",
-           "check_belt_overlaps", "max_infeed_rate"]
+           "check_belt_overlaps", "check_belt_seams", "max_infeed_rate", "extrude_polyline",
+           "table_walls_as_mesh"]
 
 #: Name of this scene in scene files (the key ``scene``).
 SCENE_NAME = "mesh_table"
@@ -217,6 +218,34 @@ def check_belt_overlaps(belts: list[Belt], source: str) -> None:
                     "edges but not area")
 
 
+def check_belt_seams(belts: list[Belt], source: str) -> None:
+    """Refuse belts that meet at a T-junction (a corner of one inside an edge of another):
+    the seam must be an edge of the floor mesh on both sides, else a sphere on it could
+    count a contact with each belt. Belts meet edge to edge (sharing both corners) or not
+    at all; split the longer edge's belt at the corner to make a T-junction acceptable."""
+    for a, belt in enumerate(belts):
+        for b, other in enumerate(belts):
+            if a == b:
+                continue
+            q = other.polygon
+            size = max(np.ptp(belt.polygon, axis=0).max(), np.ptp(q, axis=0).max())
+            tol = 1e-9 * size
+            for corner in belt.polygon:
+                for s, e in zip(q, np.roll(q, -1, axis=0)):
+                    d = e - s
+                    u = float(np.dot(corner - s, d) / np.dot(d, d))
+                    if not (0.0 < u < 1.0):
+                        continue
+                    if min(np.linalg.norm(corner - s), np.linalg.norm(corner - e)) <= tol:
+                        continue
+                    if np.linalg.norm(s + u * d - corner) <= tol:
+                        raise InvalidParameterError(
+                            f"invalid belts in {source}: a corner {corner.tolist()} of belt "
+                            f"{belt.name!r} lies inside an edge of belt {other.name!r} (a "
+                            "T-junction); belts must meet edge to edge, sharing both corners "
+                            f"(split {other.name!r} at that corner)")
+
+
 def belt_floor(belts: list[Belt]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The belts as one floor mesh at z = 0: vertices (N, 3) m (shared corners welded, so
     that seams are edges of the mesh), triangles (M, 3) (a fan per belt) and each triangle's
@@ -391,6 +420,7 @@ class MeshTable:
             raise InvalidParameterError(f"invalid belts in {source}: at least one [[belts]] "
                                         "region is needed (the floor the spheres stand on)")
         check_belt_overlaps(belts, source)
+        check_belt_seams(belts, source)
         for what, name in ([(f"meshes[{k}].material", m.material) for k, m in enumerate(meshes)]
                            + [(f"belts[{k}].material", b.material) for k, b in enumerate(belts)]
                            + [("particles.material", pm)]):
