@@ -67,9 +67,13 @@ class DemSimulation:
     positions (N, 3) m; radii (N,) m; materials: list of dicts with young_modulus (Pa),
     poisson_ratio, density (kg/m^3), friction, restitution, rolling_friction, shell_stiffness
     (N/m); walls: list of dicts with type 'plane' (point, normal), 'polygon' (vertices),
-    'strip' (x0, y0, x1, y1, z_bottom, z_top) or 'cuboid' (center, half_extents), plus material,
-    surface_velocity (m/s) and motion ({'type': 'constant', 'velocity'} or
-    {'type': 'harmonic', 'direction', 'amplitude' (m), 'period' (s), 'phase' (rad)});
+    'strip' (x0, y0, x1, y1, z_bottom, z_top), 'cuboid' (center, half_extents) or 'mesh'
+    (vertices (N, 3) m, triangles (M, 3) vertex indices, closed: bool, True to refuse an
+    open mesh, triangle_velocities (M, 3) m/s: each triangle's own surface velocity, belts;
+    two-sided, each touching face, edge and vertex counted once), plus material,
+    surface_velocity (m/s) and motion ({'type': 'constant', 'velocity'},
+    {'type': 'harmonic', 'direction', 'amplitude' (m), 'period' (s), 'phase' (rad)} or
+    {'type': 'rotation', 'axis_point' (m), 'axis', 'angular_velocity' (rad/s)}, not for planes);
     effects: names from gravity, belt, moving_walls, friction, rotation, damping,
     rolling_resistance, planar. gravity (m/s^2) defaults to (0, 0, -9.81). dt (s) defaults
     to dt_safety x the stable limit; a larger one
@@ -321,7 +325,8 @@ class RigidSimulation:
     cartridge frame (axis z); shape: {'kind': 'clump', 'centers' (n, 3) m, 'radii' (n,) m,
     'masses' (n,) kg} or {'kind': 'exact', 'z', 'r_in', 'r_out'} (stations, m; mass from the
     material's density); material: dict with young_modulus (Pa), poisson_ratio, density
-    (kg/m^3), friction, restitution; walls: 'plane' or 'polygon' dicts as for DemSimulation
+    (kg/m^3), friction, restitution; walls: 'plane', 'polygon' or 'mesh' (bead clumps
+    only; not rotating) dicts as for DemSimulation
     (surface_velocity, motion); effects: names from gravity, belt, moving_walls, friction,
     rotation, damping. angular_velocities in the world frame (rad/s). dt (s) defaults to the
     stable limit at expected_max_speed (m/s); a larger one raises UnstableTimeStepError.

@@ -73,8 +73,39 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     return 0
 
 
+def _scene_kind(path: Optional[str]) -> Optional[str]:
+    """The ``scene`` key of a TOML scene file (None: no file, or a table file without it)."""
+    if path is None:
+        return None
+    from demfem.io.toml_file import read_toml
+
+    kind = read_toml(path).get("scene")
+    return kind if isinstance(kind, str) else None
+
+
+def _cmd_run_mesh_table(args: argparse.Namespace) -> int:
+    from demfem.scenes.infeed import run_mesh_table
+    from demfem.scenes.mesh_table import MeshTable
+
+    table = MeshTable.from_toml(args.scene)
+    if args.young_modulus is not None:
+        mats = {k: dict(v) for k, v in table.materials.items()}
+        mats[table.particle_material]["young_modulus"] = float(args.young_modulus)
+        table = table.replace(materials=mats)
+    duration = args.duration if args.duration is not None else (
+        min(1.0, table.duration) if args.quick else None)
+    run_mesh_table(table, args.out, duration=duration, threads=args.threads,
+                   log=lambda line: print(line, flush=True))
+    return 0
+
+
 def _cmd_run(args: argparse.Namespace) -> int:
     from demfem.pipeline import run_pipeline
+
+    from demfem.scenes.mesh_table import SCENE_NAME as MESH_TABLE
+
+    if _scene_kind(args.scene) == MESH_TABLE:
+        return _cmd_run_mesh_table(args)
 
     duration = args.duration if args.duration is not None else (0.1 if args.quick else 1.0)
     sample = args.sample_interval if args.sample_interval is not None else min(
@@ -207,6 +238,13 @@ def _cmd_equivalence(args: argparse.Namespace) -> int:
 
 def _cmd_assess(args: argparse.Namespace) -> int:
     from demfem.assess import assess
+    from demfem.scenes.mesh_table import SCENE_NAME as MESH_TABLE
+
+    if _scene_kind(args.scene) == MESH_TABLE:
+        raise InvalidParameterError(
+            f"invalid scene {args.scene}: 'demfem assess' runs accumulation-table scenes; a "
+            f"{MESH_TABLE!r} scene runs with 'demfem run' (throughput, residence time, "
+            "steadiness), its breakage assessment is not implemented yet")
 
     model = None
     if args.stress_model is not None:
@@ -284,8 +322,9 @@ def build_parser() -> argparse.ArgumentParser:
     c.set_defaults(func=_cmd_calibrate)
     r = sub.add_parser("run", help="the main job: calibration, DEM of a table scene, analysis")
     r.add_argument("scene", nargs="?", default=None, metavar="SCENE.toml",
-                   help="table scene file (see examples/table_default.toml; default: the "
-                        "built-in default table)")
+                   help="table scene file (see examples/table_default.toml, or a "
+                        "'mesh_table' scene: examples/mesh_table/mesh_table.toml; default: "
+                        "the built-in default table)")
     r.add_argument("--duration", type=float, default=None,
                    help="simulated time of the table, s (1.0; --quick: 0.1)")
     _add_modulus(r, "Young's modulus of the glass, Pa (default: the scene's; built-in "

@@ -29,8 +29,10 @@ __all__ = [
     "polygon",
     "strip",
     "cuboid",
+    "mesh",
     "harmonic",
     "constant_velocity",
+    "rotation",
     "run",
     "from_scene",
     "refeed_removed",
@@ -99,9 +101,32 @@ def cuboid(center: Vector, half_extents: Vector, *, material: int = 0,
     return _wall("cuboid", material, None, motion, center=tuple(center), half_extents=tuple(half_extents))
 
 
+def mesh(vertices: Any, triangles: Any, *, material: int = 0, closed: bool = False,
+         surface_velocity: Optional[Vector] = None, triangle_velocities: Any = None,
+         motion: Optional[dict[str, Any]] = None) -> dict[str, Any]:
+    """Triangle-mesh wall (two-sided): ``vertices`` (N, 3) m, ``triangles`` (M, 3) vertex
+    indices; ``closed`` refuses an open surface; ``triangle_velocities`` (M, 3) m/s gives
+    each triangle its own surface velocity (several belts in one floor)."""
+    import numpy as np
+
+    w = _wall("mesh", material, surface_velocity, motion,
+              vertices=np.ascontiguousarray(vertices, dtype=float),
+              triangles=np.ascontiguousarray(triangles, dtype=np.int64), closed=bool(closed))
+    if triangle_velocities is not None:
+        w["triangle_velocities"] = np.ascontiguousarray(triangle_velocities, dtype=float)
+    return w
+
+
 def harmonic(direction: Vector, amplitude: float, period: float, phase: float = 0.0) -> dict[str, Any]:
     """Wall motion x(t) = x0 + A sin(2π t / T + φ) along ``direction``; A in m, T in s."""
     return {"type": "harmonic", "direction": tuple(direction), "amplitude": amplitude, "period": period, "phase": phase}
+
+
+def rotation(axis_point: Vector, axis: Vector, angular_velocity: float) -> dict[str, Any]:
+    """Wall motion: rotation about the axis through ``axis_point`` (m) along ``axis``
+    (right-handed) at ``angular_velocity`` rad/s (a star wheel); not for planes."""
+    return {"type": "rotation", "axis_point": tuple(axis_point), "axis": tuple(axis),
+            "angular_velocity": angular_velocity}
 
 
 def constant_velocity(velocity: Vector) -> dict[str, Any]:
@@ -315,9 +340,13 @@ def scene_walls(scene: Any, material_index: Callable[[str], int]) -> list[dict[s
                           float(motion["period"]), float(motion.get("phase", 0.0)))
         elif kind == "constant":
             mo = constant_velocity(tuple(np.asarray(motion["velocity"], float)))
+        elif kind == "rotation":
+            mo = rotation(tuple(np.asarray(motion["axis_point"], float)),
+                          tuple(np.asarray(motion["axis"], float)),
+                          float(motion["angular_velocity"]))
         else:
             raise InvalidParameterError(f"invalid wall {w.get('name')!r} motion kind = {kind!r}: "
-                                        "must be 'fixed', 'harmonic' or 'constant'")
+                                        "must be 'fixed', 'harmonic', 'constant' or 'rotation'")
         sv = w.get("surface_velocity")
         sv = None if sv is None or not np.any(np.asarray(sv)) else tuple(np.asarray(sv, float))
         mat = material_index(w.get("material", scene.particle_material))
@@ -327,9 +356,13 @@ def scene_walls(scene: Any, material_index: Callable[[str], int]) -> list[dict[s
         elif w["kind"] == "polygon":
             walls.append(polygon([list(map(float, v)) for v in np.asarray(w["vertices"])],
                                  material=mat, surface_velocity=sv, motion=mo))
+        elif w["kind"] == "mesh":
+            walls.append(mesh(w["vertices"], w["triangles"], material=mat,
+                              closed=bool(w.get("closed", False)), surface_velocity=sv,
+                              triangle_velocities=w.get("triangle_velocities"), motion=mo))
         else:
             raise InvalidParameterError(f"invalid wall {w.get('name')!r} kind = {w['kind']!r}: "
-                                        "must be 'plane' or 'polygon'")
+                                        "must be 'plane', 'polygon' or 'mesh'")
     return walls
 
 

@@ -9,7 +9,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use demfem::dem::{ContactModel, EffectSet, Material, ParticleInit, Partner, Scene, Simulation};
-use demfem::geometry::{Vec3, Wall, WallMotion, WallShape};
+use demfem::geometry::{MeshWall, Vec3, Wall, WallMotion, WallShape};
 use demfem::DemfemError;
 
 use crate::{CoreResult, PyDemfemError};
@@ -167,11 +167,12 @@ pub(crate) fn parse_wall(d: &Bound<'_, PyDict>, k: usize) -> PyResult<Wall> {
             return Err(invalid(
                 &format!("{w}.type"),
                 "missing",
-                "'plane', 'polygon', 'strip' or 'cuboid'",
+                "'plane', 'polygon', 'strip', 'cuboid' or 'mesh'",
             ))
         }
     };
     let shape = match kind.as_str() {
+        "mesh" => parse_mesh(d, &w),
         "plane" => WallShape::plane(
             get_vec3(d, "point", None, &w)?,
             get_vec3(d, "normal", None, &w)?,
@@ -209,7 +210,7 @@ pub(crate) fn parse_wall(d: &Bound<'_, PyDict>, k: usize) -> PyResult<Wall> {
             return Err(invalid(
                 &format!("{w}.type"),
                 other,
-                "'plane', 'polygon', 'strip' or 'cuboid'",
+                "'plane', 'polygon', 'strip', 'cuboid' or 'mesh'",
             ))
         }
     }
@@ -244,11 +245,17 @@ pub(crate) fn parse_wall(d: &Bound<'_, PyDict>, k: usize) -> PyResult<Wall> {
                     get_f64(&m, "phase", Some(0.0), &mw)?,
                 )
                 .map_err(PyDemfemError::from)?,
+                "rotation" => WallMotion::rotation(
+                    get_vec3(&m, "axis_point", None, &mw)?,
+                    get_vec3(&m, "axis", None, &mw)?,
+                    get_f64(&m, "angular_velocity", None, &mw)?,
+                )
+                .map_err(PyDemfemError::from)?,
                 other => {
                     return Err(invalid(
                         &format!("{mw}.type"),
                         other,
-                        "'fixed', 'constant' or 'harmonic'",
+                        "'fixed', 'constant', 'harmonic' or 'rotation'",
                     ))
                 }
             }
@@ -271,6 +278,97 @@ pub(crate) fn parse_wall(d: &Bound<'_, PyDict>, k: usize) -> PyResult<Wall> {
         surface_velocity: get_vec3(d, "surface_velocity", Some(Vec3::ZERO), &w)?,
         material: material as usize,
     })
+}
+
+/// A `{"type": "mesh", "vertices": (N, 3) m, "triangles": (M, 3) int, "closed": bool,
+/// "triangle_velocities": (M, 3) m/s or None}` wall:
+/// the core's checks (finite vertices, indices in range, no degenerate triangle, closed when
+/// asked), errors naming `w` instead of "mesh".
+fn parse_mesh(d: &Bound<'_, PyDict>, w: &str) -> Result<WallShape, DemfemError> {
+    let py_err = |e: PyErr| DemfemError::InvalidParameter {
+        field: w.to_string(),
+        value: e.to_string(),
+        allowed: "a mesh: vertices (N, 3) floats, triangles (M, 3) integers".into(),
+    };
+    let (vf, tf) = (format!("{w}.vertices"), format!("{w}.triangles"));
+    let required = |f: &str| DemfemError::InvalidParameter {
+        field: f.to_string(),
+        value: "missing".into(),
+        allowed: "required".into(),
+    };
+    let v = d
+        .get_item("vertices")
+        .map_err(py_err)?
+        .ok_or_else(|| required(&vf))?;
+    let v = crate::as_float_array(&v, &vf).map_err(py_err)?;
+    let v = float2(&v, &vf).map_err(py_err)?;
+    let vertices = vec3s(&vf, &v, None).map_err(py_err)?;
+    let t = d
+        .get_item("triangles")
+        .map_err(py_err)?
+        .ok_or_else(|| required(&tf))?;
+    let t = crate::as_int_array(&t, &tf).map_err(py_err)?;
+    let shape: Vec<usize> = t
+        .getattr("shape")
+        .and_then(|s| s.extract())
+        .map_err(py_err)?;
+    if shape.len() != 2 || shape[1] != 3 {
+        return Err(DemfemError::ShapeMismatch {
+            field: tf,
+            detail: format!("expected (M, 3), got {shape:?}"),
+        });
+    }
+    let flat = t.call_method1("reshape", (-1,)).map_err(py_err)?;
+    let flat = int1(&flat, &tf).map_err(py_err)?;
+    let flat = flat.as_array();
+    let mut triangles = Vec::with_capacity(shape[0]);
+    for k in 0..shape[0] {
+        let mut tri = [0u32; 3];
+        for c in 0..3 {
+            let i = flat[3 * k + c];
+            tri[c] = u32::try_from(i).map_err(|_| DemfemError::InvalidParameter {
+                field: format!("{tf}[{k}]"),
+                value: i.to_string(),
+                allowed: format!("vertex indices in 0..{}", vertices.len()),
+            })?;
+        }
+        triangles.push(tri);
+    }
+    let closed: bool = match d.get_item("closed").map_err(py_err)? {
+        Some(c) => c.extract().map_err(py_err)?,
+        None => false,
+    };
+    let rename = |e: DemfemError| match e {
+        DemfemError::InvalidParameter {
+            field,
+            value,
+            allowed,
+        } => DemfemError::InvalidParameter {
+            field: field.replacen("mesh", w, 1),
+            value,
+            allowed,
+        },
+        DemfemError::ShapeMismatch { field, detail } => DemfemError::ShapeMismatch {
+            field: field.replacen("mesh", w, 1),
+            detail,
+        },
+        other => other,
+    };
+    let mesh = match d.get_item("triangle_velocities").map_err(py_err)? {
+        Some(tv) if !tv.is_none() => {
+            let f = format!("{w}.triangle_velocities");
+            let tv = crate::as_float_array(&tv, &f).map_err(py_err)?;
+            let tv = float2(&tv, &f).map_err(py_err)?;
+            let tv = vec3s(&f, &tv, Some(triangles.len())).map_err(py_err)?;
+            MeshWall::with_triangle_velocities(vertices, triangles, tv)
+        }
+        _ => MeshWall::new(vertices, triangles),
+    }
+    .map_err(rename)?;
+    if closed {
+        mesh.require_closed(&format!("{w}.closed"))?;
+    }
+    Ok(WallShape::Mesh(mesh))
 }
 
 fn flat3(v: &[Vec3]) -> Vec<f64> {

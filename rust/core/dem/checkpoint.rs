@@ -18,7 +18,7 @@ use crate::geometry::Vec3;
 
 const MAGIC: &[u8; 8] = b"DEMFEMCK";
 /// Version of the checkpoint format.
-pub const CHECKPOINT_VERSION: u32 = 1;
+pub const CHECKPOINT_VERSION: u32 = 2;
 
 struct Writer(Vec<u8>);
 impl Writer {
@@ -150,6 +150,9 @@ impl Simulation {
         for v in &self.reference_wall_offset {
             w.vec3(*v);
         }
+        for a in &self.reference_wall_angle {
+            w.f64(*a);
+        }
         w.u64(self.pairs.len() as u64);
         for (p, &active) in self.pairs.iter().zip(&self.pair_active) {
             w.u32(p.i);
@@ -161,6 +164,7 @@ impl Simulation {
         w.u64(self.wall_slots.len() as u64);
         for s in &self.wall_slots {
             w.u32(s.wall);
+            w.u32(s.triangle);
             w.u8(s.active as u8);
             w.vec3(s.history);
         }
@@ -241,6 +245,10 @@ impl Simulation {
         for _ in 0..self.walls.len() {
             wall_ref.push(r.vec3()?);
         }
+        let mut wall_angle = Vec::with_capacity(self.walls.len());
+        for _ in 0..self.walls.len() {
+            wall_angle.push(r.f64()?);
+        }
         let n_pairs = r.count(data.len() / 33 + 1, "pair")?;
         let mut pairs = Vec::with_capacity(n_pairs);
         let mut pair_active = Vec::with_capacity(n_pairs);
@@ -261,7 +269,13 @@ impl Simulation {
             pair_active.push(active);
         }
         let pair_onset = vec![false; n_pairs];
-        let stride = r.count(self.walls.len().max(1), "wall stride")?.max(1);
+        // a mesh wall has a slot per triangle within reach
+        let max_stride = self
+            .walls
+            .iter()
+            .map(|w| w.mesh().map_or(1, |m| m.triangles().len()))
+            .sum::<usize>();
+        let stride = r.count(max_stride.max(1), "wall stride")?.max(1);
         let n_slots = r.count(n * stride, "wall slot")?;
         if n_slots != n * stride {
             return Err(bad("corrupt checkpoint: wall slot count".into()));
@@ -272,10 +286,22 @@ impl Simulation {
             if wall != u32::MAX && wall as usize >= self.walls.len() {
                 return Err(bad(format!("corrupt checkpoint: wall index {wall}")));
             }
+            let triangle = r.u32()?;
+            if wall != u32::MAX {
+                let n_triangles = self.walls[wall as usize]
+                    .mesh()
+                    .map_or(1, |m| m.triangles().len());
+                if triangle as usize >= n_triangles {
+                    return Err(bad(format!(
+                        "corrupt checkpoint: triangle index {triangle}"
+                    )));
+                }
+            }
             let active = r.u8()? != 0;
             let history = r.vec3()?;
             slots.push(WallContact {
                 wall,
+                triangle,
                 active,
                 history,
                 ..Default::default()
@@ -294,6 +320,7 @@ impl Simulation {
         self.reference_position = reference;
         self.alive = alive;
         self.reference_wall_offset = wall_ref;
+        self.reference_wall_angle = wall_angle;
         self.pairs = pairs;
         self.pair_active = pair_active;
         self.pair_onset = pair_onset;

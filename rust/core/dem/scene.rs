@@ -251,7 +251,11 @@ impl Scene {
         let mut any_surface = false;
         let mut any_moving = false;
         for (w, wall) in self.walls.iter().enumerate() {
-            if wall.surface_velocity != Vec3::ZERO {
+            let belts = wall.mesh().is_some_and(|m| {
+                (0..m.triangles().len() as u32)
+                    .any(|t| m.triangle_velocity(t).is_some_and(|v| v != Vec3::ZERO))
+            });
+            if wall.surface_velocity != Vec3::ZERO || belts {
                 any_surface = true;
                 need(Effect::Belt, format!("walls[{w}] has a surface velocity"))?;
             }

@@ -218,6 +218,11 @@ pub struct Simulation {
     pub(crate) wall_stride: usize,
     pub(crate) reference_position: Vec<Vec3>,
     pub(crate) reference_wall_offset: Vec<Vec3>,
+    /// Rotation angle of each wall at the last rebuild, rad (0 unless it rotates).
+    pub(crate) reference_wall_angle: Vec<f64>,
+    /// [`Wall::rotation_reach`] of each wall, m: how far a rotation by 1 rad moves it at
+    /// most (the rebuild test).
+    wall_reach: Vec<f64>,
     pub(crate) needs_rebuild: bool,
     // ---- derived, rebuilt from the state
     /// Gather lists of the pairs in contact: `active_entry[active_base[i]..][..active_len[i]]`

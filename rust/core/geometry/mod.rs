@@ -14,6 +14,10 @@
 //!   cross-checked against parry3d's triangle projection in the tests.
 //! * [`WallShape::Cuboid`]: a solid axis-aligned box, closest point through parry3d-f64's
 //!   `Cuboid` point projection (faces, edges and corners handled by parry).
+//! * [`WallShape::Mesh`]: a triangle mesh (walls from CAD), two-sided, its triangles found
+//!   through the BVH of parry3d-f64's `TriMesh`; each (particle, triangle) within reach is a
+//!   wall slot of its own, and the rule of module [`mesh`] counts each touching face, edge
+//!   and vertex once.
 //!
 //! All lengths in metres, velocities in m/s, times in seconds.
 
@@ -21,6 +25,9 @@ use parry3d_f64::query::PointQuery;
 use parry3d_f64::shape::Cuboid;
 
 use crate::error::{check_non_negative, check_positive, DemfemError, Result};
+
+pub mod mesh;
+pub use mesh::{MeshFeature, MeshWall};
 
 /// Three-component vector (x, y, z) used throughout the DEM (glam `DVec3` as re-exported by
 /// parry3d-f64).
@@ -66,6 +73,8 @@ pub enum WallShape {
         /// The parry shape used for the projection.
         shape: Cuboid,
     },
+    /// Triangle mesh, two-sided (see [`MeshWall`]); shared, so cloning a scene is cheap.
+    Mesh(std::sync::Arc<MeshWall>),
 }
 
 impl WallShape {
@@ -234,6 +243,7 @@ impl WallShape {
                     None
                 }
             }
+            WallShape::Mesh(mesh) => mesh.closest(p),
         }
     }
 }
@@ -275,7 +285,8 @@ fn closest_on_convex_polygon(
     best
 }
 
-/// Prescribed rigid motion of a wall (a pure translation of its reference geometry).
+/// Prescribed rigid motion of a wall: a translation of its reference geometry, or a
+/// rotation about a fixed axis (a star wheel, a rotating arm).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum WallMotion {
     /// The wall does not move.
@@ -295,6 +306,17 @@ pub enum WallMotion {
         period: f64,
         /// Phase φ, rad.
         phase: f64,
+    },
+    /// Rotation by θ(t) = ω t about the axis through `axis_point` along the unit `axis`
+    /// (right-handed): a point y of the reference geometry is at
+    /// c + R(θ)(y − c), moving at ω axis × (y(t) − c). Not for planes (infinite).
+    Rotation {
+        /// A point on the axis, m.
+        axis_point: Vec3,
+        /// Unit direction of the axis.
+        axis: Vec3,
+        /// Angular velocity ω, rad/s.
+        angular_velocity: f64,
     },
 }
 
@@ -323,11 +345,59 @@ impl WallMotion {
         })
     }
 
-    /// Displacement from the reference position at time t, m, and velocity, m/s.
+    /// A rotation about the axis through `axis_point` along `axis` (normalised) at
+    /// `angular_velocity` rad/s.
+    pub fn rotation(axis_point: Vec3, axis: Vec3, angular_velocity: f64) -> Result<Self> {
+        check_vec("rotation.axis_point", axis_point)?;
+        check_vec("rotation.axis", axis)?;
+        let len = axis.length();
+        if !(len > 0.0) {
+            return Err(DemfemError::invalid("rotation.axis length", len, "> 0"));
+        }
+        if !angular_velocity.is_finite() {
+            return Err(DemfemError::invalid(
+                "rotation.angular_velocity",
+                angular_velocity,
+                "finite (rad/s)",
+            ));
+        }
+        Ok(WallMotion::Rotation {
+            axis_point,
+            axis: axis / len,
+            angular_velocity,
+        })
+    }
+
+    /// Rotation angle at time t, rad (0 unless a [`WallMotion::Rotation`]).
+    #[inline]
+    pub fn angle_at(&self, t: f64) -> f64 {
+        match *self {
+            WallMotion::Rotation {
+                angular_velocity, ..
+            } => angular_velocity * t,
+            _ => 0.0,
+        }
+    }
+
+    /// `p` rotated by `angle` about the axis of a [`WallMotion::Rotation`] (Rodrigues);
+    /// `p` itself for the other motions.
+    #[inline]
+    pub fn rotate(&self, angle: f64, p: Vec3) -> Vec3 {
+        match *self {
+            WallMotion::Rotation {
+                axis_point, axis, ..
+            } => axis_point + rotate_about(axis, angle, p - axis_point),
+            _ => p,
+        }
+    }
+
+    /// Displacement from the reference position at time t, m, and velocity, m/s (zero for
+    /// a rotation, whose displacement and velocity depend on the point: [`Self::rotate`],
+    /// [`Self::angle_at`]).
     #[inline]
     pub fn offset_and_velocity(&self, t: f64) -> (Vec3, Vec3) {
         match *self {
-            WallMotion::Fixed => (Vec3::ZERO, Vec3::ZERO),
+            WallMotion::Fixed | WallMotion::Rotation { .. } => (Vec3::ZERO, Vec3::ZERO),
             WallMotion::ConstantVelocity { velocity } => (velocity * t, velocity),
             WallMotion::Harmonic {
                 direction,
@@ -348,19 +418,33 @@ impl WallMotion {
             WallMotion::Fixed => false,
             WallMotion::ConstantVelocity { velocity } => velocity != Vec3::ZERO,
             WallMotion::Harmonic { amplitude, .. } => amplitude > 0.0,
+            WallMotion::Rotation {
+                angular_velocity, ..
+            } => angular_velocity != 0.0,
         }
     }
 
-    /// Largest speed the wall reaches, m/s.
+    /// Largest speed the wall reaches, m/s (for a rotation: |ω|, the speed per metre from
+    /// the axis).
     pub fn max_speed(&self) -> f64 {
         match *self {
             WallMotion::Fixed => 0.0,
+            WallMotion::Rotation {
+                angular_velocity, ..
+            } => angular_velocity.abs(),
             WallMotion::ConstantVelocity { velocity } => velocity.length(),
             WallMotion::Harmonic {
                 amplitude, period, ..
             } => amplitude * 2.0 * std::f64::consts::PI / period,
         }
     }
+}
+
+/// `v` rotated by `angle` (rad) about the unit `axis` (Rodrigues' formula).
+#[inline]
+pub fn rotate_about(axis: Vec3, angle: f64, v: Vec3) -> Vec3 {
+    let (s, c) = angle.sin_cos();
+    v * c + axis.cross(v) * s + axis * (axis.dot(v) * (1.0 - c))
 }
 
 /// A rigid wall: shape, prescribed motion, surface velocity and material index.
@@ -388,13 +472,56 @@ impl Wall {
         }
     }
 
-    /// Validate the surface velocity (finite).
+    /// Validate the surface velocity (finite), and refuse a rotating plane.
     pub fn validate(&self) -> Result<()> {
         check_vec("wall.surface_velocity", self.surface_velocity)?;
         if let WallMotion::ConstantVelocity { velocity } = self.motion {
             check_vec("wall.velocity", velocity)?;
         }
+        if matches!(self.motion, WallMotion::Rotation { .. })
+            && matches!(self.shape, WallShape::Plane { .. })
+        {
+            return Err(DemfemError::ShapeMismatch {
+                field: "wall.motion".into(),
+                detail: "a plane cannot rotate (it is infinite); use a polygon or a mesh".into(),
+            });
+        }
         Ok(())
+    }
+
+    /// Largest distance of the wall's geometry from the axis of a rotating wall, m (0 for
+    /// the other motions): a rotation by Δθ moves no point of the wall further than this
+    /// × |Δθ|.
+    pub fn rotation_reach(&self) -> f64 {
+        let WallMotion::Rotation {
+            axis_point, axis, ..
+        } = self.motion
+        else {
+            return 0.0;
+        };
+        let radius = |v: &Vec3| {
+            let d = *v - axis_point;
+            (d - axis * axis.dot(d)).length()
+        };
+        match &self.shape {
+            WallShape::Plane { .. } => f64::INFINITY,
+            WallShape::Polygon { vertices, .. } => vertices.iter().map(radius).fold(0.0, f64::max),
+            WallShape::Mesh(m) => m.vertices().iter().map(radius).fold(0.0, f64::max),
+            WallShape::Cuboid {
+                center,
+                half_extents,
+                ..
+            } => (0..8)
+                .map(|k| {
+                    let s = Vec3::new(
+                        if k & 1 == 0 { -1.0 } else { 1.0 },
+                        if k & 2 == 0 { -1.0 } else { 1.0 },
+                        if k & 4 == 0 { -1.0 } else { 1.0 },
+                    );
+                    radius(&(*center + s * *half_extents))
+                })
+                .fold(0.0, f64::max),
+        }
     }
 
     /// Closest point, outward unit normal (wall → p) and signed distance of `p` to the wall at
@@ -404,6 +531,46 @@ impl Wall {
         self.shape
             .closest(p - offset)
             .map(|(q, n, d)| (q + offset, n, d))
+    }
+
+    /// Surface velocity at a contact with `triangle` (of a mesh wall whose triangles carry
+    /// their own, [`MeshWall::triangle_velocity`]; else the wall's), m/s.
+    #[inline(always)]
+    pub fn surface_velocity_at(&self, triangle: u32) -> Vec3 {
+        match &self.shape {
+            WallShape::Mesh(m) => m
+                .triangle_velocity(triangle)
+                .unwrap_or(self.surface_velocity),
+            _ => self.surface_velocity,
+        }
+    }
+
+    /// The triangle mesh of a [`WallShape::Mesh`] wall.
+    #[inline(always)]
+    pub fn mesh(&self) -> Option<&MeshWall> {
+        match &self.shape {
+            WallShape::Mesh(m) => Some(m),
+            _ => None,
+        }
+    }
+
+    /// What a contact slot of this wall sees of a sphere of radius `r` at `p`, the wall at
+    /// displacement `offset`: closest point, unit normal (wall → p) and distance, or `None`
+    /// out of contact. `triangle` is the slot's triangle on a mesh wall (ignored otherwise,
+    /// where the whole wall is one slot). For the initial-overlap check and the records.
+    pub fn slot_closest_at(
+        &self,
+        triangle: u32,
+        p: Vec3,
+        offset: Vec3,
+        r: f64,
+    ) -> Option<(Vec3, Vec3, f64)> {
+        match &self.shape {
+            WallShape::Mesh(m) => m
+                .contact(triangle, p - offset, r)
+                .map(|(q, n, d)| (q + offset, n, d)),
+            _ => self.closest_at(p, offset),
+        }
     }
 }
 

@@ -16,7 +16,7 @@ use parry3d_f64::shape::{Ball, Compound, ConvexPolyhedron, HalfSpace, Shape};
 
 use super::shape::{BeadClump, ExactShape};
 use crate::error::{DemfemError, Result};
-use crate::geometry::WallShape;
+use crate::geometry::{MeshWall, WallShape};
 
 /// One contact point, world frame, SI.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -772,6 +772,49 @@ pub fn clump_polygon_contacts(
                     radius_first: f64::INFINITY,
                     radius_second: r,
                     feature_first: 0,
+                    feature_second: i as u64,
+                });
+            }
+        }
+    }
+}
+
+/// Beads of a clump against a mesh wall displaced by `offset` (m) (wall first, clump
+/// second): the triangles within the clump's bounding sphere through the mesh's BVH, then
+/// each bead against each of them within its radius under the rule of
+/// [`crate::geometry::mesh`] (each touching face, edge and vertex once). The contact's
+/// `feature_first` is the triangle, so each (bead, triangle) keeps its own friction history.
+pub fn clump_mesh_contacts(
+    mesh: &MeshWall,
+    offset: &Vector3<f64>,
+    clump: &BeadClump,
+    pose: &BodyPose,
+    out: &mut Vec<ContactPoint>,
+) {
+    let local = pose.position - offset;
+    let mut near = Vec::new();
+    mesh.triangles_within(
+        Vector::new(local.x, local.y, local.z),
+        clump.bounding_radius,
+        &mut near,
+    );
+    if near.is_empty() {
+        return;
+    }
+    for (i, (c, &r)) in clump.centers.iter().zip(&clump.radii).enumerate() {
+        let centre = pose.position + pose.orientation * c;
+        let p = centre - offset;
+        let p = Vector::new(p.x, p.y, p.z);
+        for &t in &near {
+            if let Some((_, normal, distance)) = mesh.contact(t, p, r) {
+                let normal = to_nalgebra(normal);
+                out.push(ContactPoint {
+                    point: centre - normal * (0.5 * (r + distance)),
+                    normal,
+                    overlap: r - distance,
+                    radius_first: f64::INFINITY,
+                    radius_second: r,
+                    feature_first: u64::from(t),
                     feature_second: i as u64,
                 });
             }

@@ -36,7 +36,7 @@ use super::forces::{ContactMaterial, ContactModel};
 use super::shape::{MassProperties, RigidShape};
 use crate::contact::{effective_mass, effective_radius, hertz_contact_duration, hertz_stiffness};
 use crate::error::{check_positive, DemfemError, Result};
-use crate::geometry::{WallMotion, WallShape};
+use crate::geometry::{MeshWall, WallMotion, WallShape};
 
 mod contacts;
 
@@ -116,6 +116,9 @@ enum PreparedShape {
         normal: Vector3<f64>,
     },
     Polygon(PolygonWall),
+    /// A triangle mesh (beads of clumps only): each bead against each triangle under the
+    /// rule of [`crate::geometry::mesh`].
+    Mesh(std::sync::Arc<MeshWall>),
 }
 
 #[derive(Debug, Clone)]
@@ -132,6 +135,14 @@ fn prepare_wall(k: usize, wall: &RigidWall) -> Result<PreparedWall> {
             f64::NAN,
             "finite components",
         ));
+    }
+    if let WallMotion::Rotation { .. } = wall.motion {
+        return Err(DemfemError::ShapeMismatch {
+            field: format!("walls[{k}].motion"),
+            detail: "rigid scenes take fixed, constant-velocity and harmonic walls, not \
+                     rotating ones (yet)"
+                .into(),
+        });
     }
     if let WallMotion::ConstantVelocity { velocity } = wall.motion {
         if !velocity.is_finite() {
@@ -154,6 +165,7 @@ fn prepare_wall(k: usize, wall: &RigidWall) -> Result<PreparedWall> {
                 detail: "rigid scenes take plane and polygon walls, not cuboids".into(),
             })
         }
+        WallShape::Mesh(mesh) => PreparedShape::Mesh(mesh.clone()),
     };
     Ok(PreparedWall {
         shape,

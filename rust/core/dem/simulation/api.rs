@@ -148,6 +148,8 @@ impl Simulation {
             wall_stride: 1,
             reference_position: p.position.clone(),
             reference_wall_offset: vec![Vec3::ZERO; scene.walls.len()],
+            reference_wall_angle: vec![0.0; scene.walls.len()],
+            wall_reach: scene.walls.iter().map(|w| w.rotation_reach()).collect(),
             needs_rebuild: true,
             active_base: vec![0; n + 1],
             active_len: vec![0; n],
@@ -201,9 +203,12 @@ impl Simulation {
                     break;
                 }
                 let ws = self.wall_state[s.wall as usize];
-                if let Some((_, _, d)) =
-                    self.walls[s.wall as usize].closest_at(self.position[i], ws.offset)
-                {
+                if let Some((_, _, d)) = self.walls[s.wall as usize].slot_closest_at(
+                    s.triangle,
+                    self.position[i],
+                    ws.offset,
+                    self.radius[i],
+                ) {
                     let overlap = self.radius[i] - d;
                     if overlap > tolerance * self.radius[i] {
                         return Err(DemfemError::InvalidParameter {

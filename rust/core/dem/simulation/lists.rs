@@ -41,12 +41,17 @@ impl Simulation {
     pub(crate) fn refresh_wall_state(&mut self) {
         let moving = self.effects.has(Effect::MovingWalls);
         for (k, w) in self.walls.iter().enumerate() {
-            let (offset, velocity) = if moving {
-                w.motion.offset_and_velocity(self.time)
+            let (offset, velocity, angle) = if moving {
+                let (o, v) = w.motion.offset_and_velocity(self.time);
+                (o, v, w.motion.angle_at(self.time))
             } else {
-                (Vec3::ZERO, Vec3::ZERO)
+                (Vec3::ZERO, Vec3::ZERO, 0.0)
             };
-            self.wall_state[k] = WallState { offset, velocity };
+            self.wall_state[k] = WallState {
+                offset,
+                velocity,
+                angle,
+            };
         }
     }
 
@@ -359,57 +364,59 @@ impl Simulation {
             }
         }
         self.build_gather_lists();
-        // ---- wall slots: walls within reach of each particle (the others are skipped)
+        // ---- wall slots: walls within reach of each particle (the others are skipped); on
+        // a mesh wall, each triangle within reach is a slot of its own
         std::mem::swap(&mut self.wall_slots, &mut self.old_slots);
         let old_stride = self.wall_stride;
-        let mut counts = vec![0usize; n];
+        let mut found: Vec<(u32, u32)> = Vec::new();
+        let mut start = vec![0usize; n + 1];
+        let mut triangles: Vec<u32> = Vec::new();
         let mut stride = 1usize;
         for i in 0..n {
-            if !self.alive[i] {
-                continue;
-            }
-            let reach = self.radius[i] + self.skin;
-            for (w, wall) in self.walls.iter().enumerate() {
-                if let Some((_, _, d)) =
-                    wall.closest_at(self.position[i], self.wall_state[w].offset)
-                {
-                    if d < reach {
-                        counts[i] += 1;
+            if self.alive[i] {
+                let reach = self.radius[i] + self.skin;
+                for (w, wall) in self.walls.iter().enumerate() {
+                    let ws = self.wall_state[w];
+                    // the particle in the wall's reference frame
+                    let p = wall.motion.rotate(-ws.angle, self.position[i] - ws.offset);
+                    if let Some(mesh) = wall.mesh() {
+                        triangles.clear();
+                        mesh.triangles_within(p, reach, &mut triangles);
+                        found.extend(triangles.iter().map(|&t| (w as u32, t)));
+                    } else if let Some((_, _, d)) = wall.shape.closest(p) {
+                        if d < reach {
+                            found.push((w as u32, 0));
+                        }
                     }
                 }
             }
-            stride = stride.max(counts[i]);
+            start[i + 1] = found.len();
+            stride = stride.max(start[i + 1] - start[i]);
         }
         self.wall_stride = stride;
         self.wall_slots.clear();
         self.wall_slots.resize(n * stride, WallContact::default());
         for i in 0..n {
-            if counts[i] == 0 {
-                continue;
-            }
-            let reach = self.radius[i] + self.skin;
-            let mut k = 0;
-            for (w, wall) in self.walls.iter().enumerate() {
-                if let Some((_, _, d)) =
-                    wall.closest_at(self.position[i], self.wall_state[w].offset)
-                {
-                    if d < reach {
-                        let carried = self
-                            .old_slots
-                            .get(i * old_stride..(i + 1) * old_stride)
-                            .and_then(|s| s.iter().find(|s| s.wall == w as u32).copied());
-                        self.wall_slots[i * stride + k] = carried.unwrap_or(WallContact {
-                            wall: w as u32,
-                            ..Default::default()
-                        });
-                        k += 1;
-                    }
-                }
+            for (k, &(wall, triangle)) in found[start[i]..start[i + 1]].iter().enumerate() {
+                let carried = self
+                    .old_slots
+                    .get(i * old_stride..(i + 1) * old_stride)
+                    .and_then(|s| {
+                        s.iter()
+                            .find(|s| s.wall == wall && s.triangle == triangle)
+                            .copied()
+                    });
+                self.wall_slots[i * stride + k] = carried.unwrap_or(WallContact {
+                    wall,
+                    triangle,
+                    ..Default::default()
+                });
             }
         }
         self.reference_position.clone_from(&self.position);
         for (k, ws) in self.wall_state.iter().enumerate() {
             self.reference_wall_offset[k] = ws.offset;
+            self.reference_wall_angle[k] = ws.angle;
         }
         self.refresh_contact_constants();
         self.needs_rebuild = false;

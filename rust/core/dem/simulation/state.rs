@@ -53,7 +53,7 @@ pub(crate) struct PairOut {
 }
 
 /// A candidate particle–wall contact slot: the state the step carries and the index of its
-/// law constants (40 bytes). Its force and torque go to [`WallOut`], the record-only values
+/// law constants (40 bytes), and the triangle of a mesh wall. Its force and torque go to [`WallOut`], the record-only values
 /// to [`WallDetail`], as for pairs.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct WallContact {
@@ -68,6 +68,10 @@ pub(crate) struct WallContact {
     /// Law constants of this particle against this wall: index into the contact table
     /// (`Simulation::contact_table`; derived, not checkpointed).
     pub(crate) k: u32,
+    /// The triangle of a mesh wall this slot holds (each triangle within reach of a particle
+    /// is a slot of its own); 0 for the other walls. Fits in the slot's padding: still 40
+    /// bytes.
+    pub(crate) triangle: u32,
 }
 
 impl Default for WallContact {
@@ -79,6 +83,7 @@ impl Default for WallContact {
             planar_pass: false,
             history: Vec3::ZERO,
             k: 0,
+            triangle: 0,
         }
     }
 }
@@ -107,11 +112,13 @@ pub(crate) struct WallDetail {
     pub(super) onset_tangential_speed: f64,
 }
 
-/// Current position offset and velocity of each wall.
+/// Current position offset and velocity of each wall, and its rotation angle (rad; 0 but
+/// for a rotating wall, whose offset and velocity are zero).
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct WallState {
     pub(super) offset: Vec3,
     pub(super) velocity: Vec3,
+    pub(super) angle: f64,
 }
 
 /// Contacts begun (onsets) and ended in one chunk of the pair list at one force evaluation.

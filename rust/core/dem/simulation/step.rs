@@ -308,6 +308,9 @@ impl Simulation {
         let mut moved = max_disp2 > half_skin * half_skin;
         for (k, ws) in self.wall_state.iter().enumerate() {
             moved |= (ws.offset - self.reference_wall_offset[k]).length() > half_skin;
+            // a rotation by Δθ moves no point of the wall further than reach × |Δθ|
+            moved |=
+                (ws.angle - self.reference_wall_angle[k]).abs() * self.wall_reach[k] > half_skin;
         }
         self.needs_rebuild = moved;
         if self.record_every > 0 && self.steps % self.record_every == 0 {

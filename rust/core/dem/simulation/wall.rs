@@ -9,7 +9,7 @@ use super::pair::PairCtx;
 use super::state::{WallContact, WallDetail, WallOut, WallState};
 use super::{on, NO_WALL};
 use crate::dem::effects::{Effect, EffectSet};
-use crate::geometry::{Vec3, Wall, WallShape};
+use crate::geometry::{rotate_about, Vec3, Wall, WallMotion, WallShape};
 
 /// Read-only context of the wall kernels (run in the force phase, next to the pairs).
 pub(super) struct WallCtx<'a> {
@@ -69,17 +69,42 @@ pub(super) fn wall_touch<const E: u16>(
     } else {
         WallState::default()
     };
-    let Some((point, out_normal, dist)) = wall_hit(wall, x, moving.then_some(ws.offset), r) else {
+    let rotation = match wall.motion {
+        WallMotion::Rotation {
+            axis_point,
+            axis,
+            angular_velocity,
+        } if moving => Some((axis_point, axis, angular_velocity)),
+        _ => None,
+    };
+    let hit = match rotation {
+        // in the wall's reference frame, then back
+        Some((_, axis, _)) => wall_hit(wall, s.triangle, wall.motion.rotate(-ws.angle, x), None, r)
+            .map(|(q, n, d)| {
+                (
+                    wall.motion.rotate(ws.angle, q),
+                    rotate_about(axis, ws.angle, n),
+                    d,
+                )
+            }),
+        None => wall_hit(wall, s.triangle, x, moving.then_some(ws.offset), r),
+    };
+    let Some((point, out_normal, dist)) = hit else {
         end_wall_contact(s);
         return None;
     };
     let n = -out_normal; // from the particle towards the wall
+    let mut wall_v = wall_velocity::<E>(wall, s.triangle, ws, n, c.shared.effects);
+    if let Some((axis_point, axis, angular_velocity)) = rotation {
+        // the wall's material point at the contact: ω × (q − c)
+        wall_v += (axis * angular_velocity).cross(point - axis_point);
+    }
     Some(WallTouch {
         point,
         n,
         overlap: r - dist,
         arm: dist.max(0.0),
-        wall_v: wall_velocity::<E>(wall, ws, n, c.shared.effects),
+        wall_v,
     })
 }
 
@@ -95,10 +120,11 @@ pub(super) fn end_wall_contact(s: &mut WallContact) {
 
 /// Velocity of the wall's material at a contact with normal `n` (particle towards wall),
 /// m/s: the wall's motion (`ws`, zero without `moving_walls`) plus the belt's surface velocity
-/// tangent to the contact.
+/// tangent to the contact (on a mesh wall with belts, that of the slot's `triangle`).
 #[inline(always)]
 pub(super) fn wall_velocity<const E: u16>(
     wall: &Wall,
+    triangle: u32,
     ws: WallState,
     n: Vec3,
     effects: EffectSet,
@@ -106,7 +132,7 @@ pub(super) fn wall_velocity<const E: u16>(
     let moving = on::<E>(effects, Effect::MovingWalls);
     let mut wall_v = ws.velocity;
     if on::<E>(effects, Effect::Belt) {
-        let s_v = wall.surface_velocity;
+        let s_v = wall.surface_velocity_at(triangle);
         let belt = s_v - s_v.dot(n) * n;
         wall_v = if moving { wall_v + belt } else { belt };
     }
@@ -115,11 +141,13 @@ pub(super) fn wall_velocity<const E: u16>(
 
 /// Closest point, unit normal (wall → x) and distance of a wall slot when the sphere of
 /// radius r touches it. Half-spaces (the belt) by hand: one dot product, nothing else when
-/// out of reach.
+/// out of reach. On a mesh wall, the slot's `triangle` under the rule of
+/// [`crate::geometry::mesh`] (each touching face, edge and vertex counted once).
 /// `offset` is `None` for walls that do not move (no `moving_walls` effect).
 #[inline(always)]
 pub(super) fn wall_hit(
     wall: &Wall,
+    triangle: u32,
     x: Vec3,
     offset: Option<Vec3>,
     r: f64,
@@ -134,6 +162,11 @@ pub(super) fn wall_hit(
             } else {
                 None
             }
+        }
+        WallShape::Mesh(mesh) => {
+            let p = offset.map_or(x, |o| x - o);
+            let (q, n, d) = mesh.contact(triangle, p, r)?;
+            Some((offset.map_or(q, |o| q + o), n, d))
         }
         _ => match wall.closest_at(x, offset.unwrap_or(Vec3::ZERO)) {
             Some(h) if h.2 < r => Some(h),

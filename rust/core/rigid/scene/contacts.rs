@@ -10,11 +10,11 @@ use nalgebra::Vector3;
 
 use super::{PreparedShape, RigidOnset, RigidScene};
 use crate::contact::effective_mass;
-use crate::error::Result;
+use crate::error::{DemfemError, Result};
 use crate::rigid::collision::{
-    clump_clump_contacts, clump_exact_contacts, clump_plane_contacts, clump_polygon_contacts,
-    exact_exact_contacts, exact_plane_contacts, exact_polygon_contacts, BodyPose, ContactPoint,
-    Plane,
+    clump_clump_contacts, clump_exact_contacts, clump_mesh_contacts, clump_plane_contacts,
+    clump_polygon_contacts, exact_exact_contacts, exact_plane_contacts, exact_polygon_contacts,
+    BodyPose, ContactPoint, Plane,
 };
 use crate::rigid::forces::ContactModel;
 use crate::rigid::shape::{BoundingCapsule, RigidShape};
@@ -205,6 +205,17 @@ impl RigidScene {
                                     )?
                                 }
                             }
+                        }
+                        (PreparedShape::Mesh(mesh), RigidShape::Clump(clump)) => {
+                            clump_mesh_contacts(mesh, &offset, clump, &pose, &mut contacts)
+                        }
+                        (PreparedShape::Mesh(_), RigidShape::Exact(_)) => {
+                            return Err(DemfemError::ShapeMismatch {
+                                field: format!("walls[{}]", p - n_planes),
+                                detail: "a mesh wall takes bead clumps and spheres, not exact \
+                                         shapes (yet)"
+                                    .into(),
+                            });
                         }
                         (PreparedShape::Polygon(polygon), RigidShape::Clump(clump)) => {
                             clump_polygon_contacts(polygon, &offset, clump, &pose, &mut contacts)

@@ -35,7 +35,7 @@ unsafe fn plane_lanes<const E: u16>(c: &WallCtx<'_>, w: u32) -> Option<PlaneLane
         WallState::default()
     };
     let n = -normal;
-    let wall_v = wall_velocity::<E>(wall, ws, n, c.shared.effects);
+    let wall_v = wall_velocity::<E>(wall, 0, ws, n, c.shared.effects);
     let bc = |v: Vec3| V4 {
         x: _mm256_set1_pd(v.x),
         y: _mm256_set1_pd(v.y),
@@ -295,7 +295,9 @@ unsafe fn plane_scatter<const E: u16, const R: bool>(
                 let wall = &c.walls[s.wall as usize];
                 let offset = moving.then(|| c.wall_state[s.wall as usize].offset);
                 let x = c.shared.position[first + i];
-                if let Some((point, _, _)) = wall_hit(wall, x, offset, c.shared.radius[first + i]) {
+                if let Some((point, _, _)) =
+                    wall_hit(wall, s.triangle, x, offset, c.shared.radius[first + i])
+                {
                     d.point = point;
                 }
             }
