@@ -19,7 +19,8 @@ use demfem::rigid::{
 };
 use demfem::DemfemError;
 
-use crate::dem::{array_n3, get_f64, invalid, parse_wall, shape_err, vec3s};
+use crate::dem::{array_n3, get_f64, invalid, shape_err, vec3s};
+use crate::dem_walls::parse_wall;
 use crate::PyDemfemError;
 
 /// Effects a rigid scene can run (the table's, without "planar" and "rolling_resistance").
