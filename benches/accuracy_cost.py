@@ -622,7 +622,7 @@ def knob_shapes(quick: bool, img: Path) -> Table:
     engine) on the same small table: the distributions the risk needs, and the cost."""
     from demfem.equivalence import StudyConfig, compare, run_particle
 
-    cfg = StudyConfig(t_end=0.6 if quick else 2.0)
+    cfg = StudyConfig(t_end=0.4 if quick else 2.0)
     results = {}
     for particle in ("sphere", "clump", "cylinder"):
         results[particle] = run_particle(cfg, particle)
