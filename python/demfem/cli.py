@@ -129,6 +129,17 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
                 progress=progress)
     print(f"\nran {res.ran}, skipped {res.skipped} already finished; table: {res.table_path}")
     print(res.table_path.read_text(), end="")
+    if args.rank_by:
+        missing = [r for r in res.records if args.rank_by not in r["result"]]
+        if missing:
+            raise InvalidParameterError(
+                f"invalid --rank-by {args.rank_by!r}: not a result of the runner (results: "
+                f"{sorted(res.records[0]['result'])})")
+        ranked = sorted(res.records, key=lambda r: float(r["result"][args.rank_by]))
+        print(f"ranked by {args.rank_by} (lowest first):")
+        for k, r in enumerate(ranked, 1):
+            point = ", ".join(f"{n}={r['params'][n]}" for n in grid)
+            print(f"  {k:3d}  {point}  {args.rank_by} = {float(r['result'][args.rank_by]):.4g}")
     return 0
 
 
@@ -350,6 +361,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="Dask scheduler address (tcp://host:8786), or 'serial'; "
                         "default: a LocalCluster on this machine")
     s.add_argument("--workers", type=int, default=None, help="LocalCluster worker processes")
+    s.add_argument("--rank-by", default=None, metavar="KEY",
+                   help="print the points ranked by this result (lowest first), e.g. "
+                        "broken_per_hour with --runner demfem.assess.sweep_runner:risk_point")
     s.set_defaults(func=_cmd_sweep)
     f5 = _add_study(sub, "fig5", "Fig. 5: first-line force for A, T, V_belt and the gentlest "
                     "set-up")

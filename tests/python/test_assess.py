@@ -385,3 +385,22 @@ def test_risk_rises_with_belt_speed_on_a_small_table(tmp_path):
     forces, hourly = zip(*risk)
     assert list(forces) == sorted(forces) and forces[0] < forces[-1]
     assert list(hourly) == sorted(hourly) and hourly[-1] > 10 * hourly[0]
+
+
+def test_setups_ranked_by_risk_through_demfem_sweep(tmp_path, capsys):
+    """`demfem sweep --runner demfem.assess.sweep_runner:risk_point --rank-by
+    broken_per_hour`: one assessment per point (a small table here), ranked lowest first;
+    an unknown table field and an unknown ranking key are refused, naming them."""
+    base = ["sweep", "--runner", "demfem.assess.sweep_runner:risk_point", "--grid",
+            "n_spheres=30", "--grid", "width=0.1", "--grid", "length=0.1", "--grid",
+            "tilted_wall_length=0.05", "--grid", "duration=0.3", "--scheduler", "serial"]
+    assert main([*base, "--grid", "belt_velocity=0.3,0.1", "--rank-by", "broken_per_hour",
+                 "--out", str(tmp_path / "a")]) == 0
+    out = capsys.readouterr().out
+    ranking = out[out.index("ranked by broken_per_hour"):].splitlines()[1:]
+    assert "belt_velocity=0.1" in ranking[0] and "belt_velocity=0.3" in ranking[1]
+    assert main([*base, "--grid", "belt_speed=0.1", "--out", str(tmp_path / "b")]) == 2
+    assert "belt_speed" in capsys.readouterr().err
+    assert main([*base, "--grid", "belt_velocity=0.1", "--rank-by", "nope",
+                 "--out", str(tmp_path / "a")]) == 2
+    assert "nope" in capsys.readouterr().err
