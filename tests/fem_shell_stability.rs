@@ -5,36 +5,16 @@
 //! with every aᵢ ≥ 0, so it stays within [0, 2 × static]. Checked: no NaN, the energy
 //! balance closes, the deflection respects that bound (and reaches well above the static
 //! value, so the run is dynamic), and a step above the limit is refused.
+mod common;
+
+use common::grid;
 use demfem::error::DemfemError;
 use demfem::fem::mesh::TriMesh;
 use demfem::fem::shell::{ShellExplicit, ShellModel};
 use demfem::fem::LinearElastic;
 
 fn plate(n: usize, side: f64, h: f64) -> TriMesh {
-    let mut nodes = Vec::new();
-    for j in 0..=n {
-        for i in 0..=n {
-            nodes.push([side * i as f64 / n as f64, side * j as f64 / n as f64, 0.0]);
-        }
-    }
-    let id = |i: usize, j: usize| j * (n + 1) + i;
-    let mut triangles = Vec::new();
-    for j in 0..n {
-        for i in 0..n {
-            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
-            if (i + j) % 2 == 0 {
-                triangles.extend([[a, b, c], [a, c, d]]);
-            } else {
-                triangles.extend([[a, b, d], [b, c, d]]);
-            }
-        }
-    }
-    let thickness = vec![h; triangles.len()];
-    TriMesh {
-        nodes,
-        triangles,
-        thickness,
-    }
+    grid(n, n, h, |s, t| [side * s, side * t, 0.0])
 }
 
 #[test]
