@@ -9,8 +9,8 @@ from typing import Any, Optional
 
 import numpy as np
 
-from demfem.assess.risk_stage import (cartridge_risk, event_probabilities, risk_map,
-                                      steady_state, worst_events)
+from demfem.assess.risk_stage import (cartridge_risk, event_hazard, event_probabilities,
+                                      risk_map, steady_state, worst_events)
 
 __all__ = ["risk_document"]
 
@@ -82,9 +82,10 @@ def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[st
               float(pos[:, 1].min()) - pad, float(pos[:, 1].max()) + pad)
     rmap = risk_map(events, p["p_event"], window, extent)
     inside = (events["time"] >= window[0]) & (events["time"] <= window[1])
-    h_in = float(-np.log1p(-p["p_inner"][inside]).sum())
-    h_out = float(-np.log1p(-p["p_outer"][inside]).sum())
-    hazard = -np.log1p(-p["p_event"])
+    # shares of the cartridges' hazard: an impact of two cartridges loads both
+    h_in = float(event_hazard(events, p["p_inner"])[inside].sum())
+    h_out = float(event_hazard(events, p["p_outer"])[inside].sum())
+    hazard = event_hazard(events, p["p_event"])
     h_all = float(hazard[inside].sum())
     by_wall = {name: float(hazard[inside & (events["wall"] == k)].sum()) / h_all
                for k, name in enumerate(wall_names)

@@ -46,7 +46,8 @@ from demfem.risk import (INNER_SURFACE, OUTER_SURFACE, SCG_BOROSILICATE, SlowCra
 from demfem.risk.fatigue import half_sine_sn_factor
 
 __all__ = ["DEFAULT_THROUGHPUT", "event_probabilities", "surface_probability",
-           "equivalent_stress", "cartridge_risk", "steady_state", "worst_events", "risk_map"]
+           "equivalent_stress", "cartridge_risk", "event_hazard", "steady_state",
+           "worst_events", "risk_map"]
 
 #: Default throughput of the filling line, cartridges per hour: a planning assumption
 #: (6000/h = 100 per minute, a mid-range filling line), not a property of the table.
@@ -148,6 +149,13 @@ def cartridge_risk(events: np.ndarray, p_event: np.ndarray, n: int, removal_time
             if mean_on > 0 else 0.0}
 
 
+def event_hazard(events: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """The hazard each event puts on the cartridges: −ln(1 − P_k) times the cartridges it
+    loads (2 for two cartridges, 1 against a wall, ``j`` = −1), so that sums of it are sums
+    of the cartridges' hazards."""
+    return -np.log1p(-np.asarray(p, float)) * np.where(events["j"] >= 0, 2.0, 1.0)
+
+
 def steady_state(events: np.ndarray, p_event: np.ndarray,
                  window: tuple[float, float]) -> dict[str, Any]:
     """How steady the window is: events and hazard (Σ −ln(1 − P_k), both partners) per second
@@ -157,7 +165,7 @@ def steady_state(events: np.ndarray, p_event: np.ndarray,
     mid = 0.5 * (t0 + t1)
     half = 0.5 * (t1 - t0)
     t = events["time"]
-    h = -np.log1p(-np.asarray(p_event, float)) * np.where(events["j"] >= 0, 2.0, 1.0)
+    h = event_hazard(events, p_event)
     a = (t >= t0) & (t < mid)
     b = (t >= mid) & (t <= t1)
     n1, n2 = int(a.sum()), int(b.sum())
@@ -209,7 +217,7 @@ def risk_map(events: np.ndarray, p_event: np.ndarray, window: tuple[float, float
     check_range("extent x_max", x1, x0, math.inf)
     check_range("extent y_max", y1, y0, math.inf)
     sel = (events["time"] >= window[0]) & (events["time"] <= window[1])
-    h = -np.log1p(-np.asarray(p_event, float)) * np.where(events["j"] >= 0, 2.0, 1.0)
+    h = event_hazard(events, p_event)
     edges = (np.linspace(x0, x1, bins + 1), np.linspace(y0, y1, bins + 1))
     hz, ex, ey = np.histogram2d(events["x"][sel], events["y"][sel], bins=edges,
                                 weights=h[sel])

@@ -285,8 +285,8 @@ class _Recorder:
         table["impact_angle"] = np.arctan2(raw["tangential_speed"], raw["normal_speed"])
         table["x"], table["y"], table["z"] = raw["point"].T if len(table) else ([], [], [])
         if len(table):
-            zi = coordination[_nearest_frame(times, raw["time"]), raw["i"]]
-            table["coordination_i"] = np.where(np.isfinite(zi), zi, -1).astype(np.int64)
+            frame = _nearest_frame(times, raw["time"])
+            table["coordination_i"] = _coordination_at(coordination, frame, raw["i"])
         return table[np.argsort(table["time"], kind="stable")]
 
     def onset_table(self, times: np.ndarray, coordination: np.ndarray) -> np.ndarray:
@@ -297,10 +297,8 @@ class _Recorder:
         table["impact_angle"] = np.arctan2(raw["tangential_speed"], raw["normal_speed"])
         if len(table):
             frame = _nearest_frame(times, raw["time"])
-            zi = coordination[frame, raw["i"]]
-            zj = coordination[frame, raw["j"]]
-            table["coordination_i"] = np.where(np.isfinite(zi), zi, -1).astype(np.int64)
-            table["coordination_j"] = np.where(np.isfinite(zj), zj, -1).astype(np.int64)
+            table["coordination_i"] = _coordination_at(coordination, frame, raw["i"])
+            table["coordination_j"] = _coordination_at(coordination, frame, raw["j"])
         return table[np.argsort(table["time"], kind="stable")]
 
     def save_partial(self, path: Path) -> None:
@@ -323,6 +321,13 @@ class _Recorder:
                                     ("i", "j", "time", "normal_speed", "tangential_speed",
                                      "point")}]
             self.removal_times = np.array(data["removal_times"], float)
+
+
+def _coordination_at(coordination: np.ndarray, frame: np.ndarray,
+                     sphere: np.ndarray) -> np.ndarray:
+    """Coordination of each ``sphere`` at its ``frame`` as int64; −1 where it had left."""
+    z = coordination[frame, sphere]
+    return np.where(np.isfinite(z), z, -1).astype(np.int64)
 
 
 def _nearest_frame(frame_times: np.ndarray, t: np.ndarray) -> np.ndarray:
