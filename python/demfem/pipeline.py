@@ -105,23 +105,14 @@ def _prepare_folder(out: Path, settings: dict[str, Any], fresh: bool) -> Optiona
     is the same run (to resume or reuse), else None after clearing the old outputs (fresh)
     or refusing them."""
     from demfem.io.atomic import clean_stale_temporaries
+    from demfem.io.strict_json import read_record
     from demfem.studies.table_run import settings_differences
 
     clean_stale_temporaries(out)
     record_path = out / _RUN_RECORD
-    previous = None
-    if record_path.exists():
-        try:
-            previous = json.loads(record_path.read_text(encoding="utf-8"))
-            if not isinstance(previous, dict) or "settings" not in previous:
-                raise ValueError("no 'settings'")
-        except (OSError, UnicodeDecodeError, ValueError) as exc:
-            if not fresh:
-                raise CheckpointError(f"damaged run record {record_path}: {exc}; start "
-                                      "afresh (fresh=True, demfem run --fresh)") from None
-            previous = None
-    elif not fresh and any((out / n).exists() for n in
-                           ("summary.json", "table_run.npz", _CHECKPOINT, "vtk")):
+    previous = read_record(record_path, ("settings",), fresh, "run record", "demfem run")
+    if not record_path.exists() and not fresh and any(
+            (out / n).exists() for n in ("summary.json", "table_run.npz", _CHECKPOINT, "vtk")):
         raise SettingsMismatchError(
             f"the output folder {out} holds another run (without a run record {_RUN_RECORD}"
             "): choose another output folder, or replace it (fresh=True, demfem run "

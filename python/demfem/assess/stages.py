@@ -14,7 +14,8 @@ import json
 from pathlib import Path
 from typing import Any, Iterable, Mapping
 
-from demfem.errors import CheckpointError, SettingsMismatchError
+from demfem.errors import SettingsMismatchError
+from demfem.io.strict_json import read_record
 
 __all__ = ["STAGES", "StageBook"]
 
@@ -38,17 +39,8 @@ class StageBook:
         self.path = self.out / _FILE
         self.settings = json.loads(_dumps(settings))
         self.completed: dict[str, dict[str, str]] = {}
-        previous = None
-        if self.path.exists():
-            try:
-                previous = json.loads(self.path.read_text(encoding="utf-8"))
-                if not isinstance(previous, dict) or not {"settings", "completed"} <= set(previous):
-                    raise ValueError("missing 'settings' or 'completed'")
-            except (OSError, UnicodeDecodeError, ValueError) as exc:
-                if not fresh:
-                    raise CheckpointError(f"damaged stage record {self.path}: {exc}; start "
-                                          "afresh (fresh=True, demfem assess --fresh)") from None
-                previous = None
+        previous = read_record(self.path, ("settings", "completed"), fresh, "stage record",
+                               "demfem assess")
         if previous is not None and not fresh:
             diff = settings_differences(previous["settings"], self.settings)
             if diff:
