@@ -96,8 +96,11 @@ def impact_events(run, min_speed: float = DEFAULT_MIN_SPEED) -> tuple[np.ndarray
         ev["x"], ev["y"], ev["z"] = point[:, 0], point[:, 1], point[:, 2]
     names = [str(n) for n in run.info.get("wall_names", [])]
     w = np.asarray(run.wall_onsets)
-    impact_wall = np.array([names[int(k)] not in NOT_IMPACTS if int(k) < len(names) else True
-                            for k in w["wall"]], bool) if len(w) else np.zeros(0, bool)
+    # per wall index: is a contact with it an impact (walls not named in the run: yes)
+    impact_by_wall = np.array([n not in NOT_IMPACTS for n in names]
+                              + [True] * (int(w["wall"].max()) + 1 - len(names) if len(w) else 0),
+                              bool)
+    impact_wall = impact_by_wall[np.asarray(w["wall"], np.int64)]
     w_speed = np.asarray(w["normal_speed"], float)
     w_keep = impact_wall & (w_speed >= v_min)
     ws = w[w_keep]
