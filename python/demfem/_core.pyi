@@ -107,6 +107,7 @@ class DemSimulation:
         record_every: int = 0,
         record_onsets: bool = False,
         removal_plane: Optional[tuple[tuple[float, float, float], tuple[float, float, float]]] = None,
+        record_events: bool = False,
     ) -> DemSimulation: ...
     def removals(self) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint32]]:
         """Particles removed through the outlet plane: times (s) and indices."""
@@ -179,6 +180,13 @@ class DemSimulation:
     def contacts(self) -> dict[str, npt.NDArray[Any]]:
         """Active contacts: particle, partner, partner_is_wall, normal (K, 3), normal_force (N),
         tangential_force (K, 3) (N), overlap (m), point (K, 3) (m)."""
+    def events(self) -> dict[str, npt.NDArray[Any]]:
+        """Whole contacts that ended (record_events=True): time, duration (s), particle,
+        partner, partner_is_wall, normal_speed, tangential_speed at onset (m/s), position,
+        partner_position (K, 3) (m), peak_normal_force (N), normal_impulse (N s),
+        peak_tangential_force (N), max_overlap (m), complete."""
+    def open_events(self) -> dict[str, npt.NDArray[Any]]:
+        """The contacts open now, as events so far (complete False)."""
     def clear_records(self) -> None: ...
     def set_phase_timing(self, on: bool) -> None:
         """Start (True, from zero) or stop the per-thread clock of the step's two phases."""

@@ -209,6 +209,7 @@ def from_scene(
     record_every: int = 0,
     record_onsets: bool = True,
     linear_stiffness: Optional[tuple[float, float]] = None,
+    record_events: bool = False,
 ) -> DemSimulation:
     """Build the engine from an engine-neutral scene description
     (:class:`demfem.scenes.table.SceneDescription`).
@@ -223,6 +224,9 @@ def from_scene(
     thickness and body mid-surface radius); walls do not bend (infinite shell stiffness).
     ``dt`` (s) defaults to ``dt_safety`` times the stable limit; a larger one is refused.
     Contact onsets are logged (``record_onsets``) because the FEM load cases come from them.
+    ``record_events`` logs every whole contact with its duration (s), peak normal and
+    tangential force (N), normal impulse (N s) and largest overlap (m), measured step by step
+    (``sim.events()``, ``sim.open_events()``); off, it costs nothing.
     A scene that re-feeds removed spheres (``scene.refeed``) is run with
     ``run(sim, t, refeed=scene.refeed)`` or :func:`demfem.studies.run_table`.
     """
@@ -285,7 +289,7 @@ def from_scene(
         model=engine_model, linear_stiffness=linear_stiffness, dt=dt, dt_safety=dt_safety,
         expected_max_speed=expected_max_speed,
         threads=threads, record_every=record_every, record_onsets=record_onsets,
-        removal_plane=removal_plane,
+        removal_plane=removal_plane, record_events=record_events,
     )
 
 

@@ -14,8 +14,17 @@ Position: the record samples the centres every ``sample_interval``; the centres 
 the onset time are interpolated linearly between the two samples around it (nearest sample if
 a partner left in between), and the contact point is c_i + r_i (c_j − c_i)/|c_j − c_i|.
 
+Measured contacts: a run recorded with ``record_events`` (as ``demfem assess`` records it)
+holds every whole contact with its duration, peak normal force and normal impulse measured in
+the DEM step by step (:data:`demfem.analysis.contact_events.CONTACT_EVENT_DTYPE`); the events
+are then made from those (``measured`` True), and their contact point is the engine's at
+onset. Without them (older runs) the events are the onsets, and force and duration come from
+the calibrated law at the onset speed in the stress stage.
+
 Minimum-speed filter: onsets with a normal speed below ``min_speed`` (default 5 mm/s) are
-dropped. Most onsets of a packed table are resting chatter (spheres in a pack touching and
+dropped (with measured contacts, only those whose measured peak force is also below
+``min_force``, the force of an impact at ``min_speed``: a contact that began gently but was
+then pressed hard by the queue behind it is kept). Most onsets of a packed table are resting chatter (spheres in a pack touching and
 parting at a few mm/s); at 5 mm/s two default cartridges meet with a peak force of ≈ 0.27 N
 (Hertz–Reissner, E = 45 GPa), a σ1 of ≈ 0.4 MPa: negligible for breakage, so the filter only
 sheds bookkeeping. The report states how many onsets it dropped and their largest speed.
@@ -43,11 +52,13 @@ DEFAULT_MIN_SPEED = 5e-3
 #: Fields of the event table: partners i, j (j = -1 for a wall), partner code (0 sphere,
 #: 1 wall), the wall's index in the run's ``info["wall_names"]`` (-1 for a sphere), onset
 #: time (s), contact point (m), normal and tangential relative speed at onset (m/s), impact
-#: angle atan2(v_t, v_n) (rad).
+#: angle atan2(v_t, v_n) (rad); measured in the DEM (``measured``; NaN otherwise): peak
+#: normal force (N), contact duration (s), normal impulse (N s).
 EVENT_DTYPE = np.dtype([
     ("i", "i8"), ("j", "i8"), ("partner", "i8"), ("wall", "i8"), ("time", "f8"),
     ("x", "f8"), ("y", "f8"), ("z", "f8"),
     ("normal_speed", "f8"), ("tangential_speed", "f8"), ("impact_angle", "f8"),
+    ("peak_force", "f8"), ("duration", "f8"), ("impulse", "f8"), ("measured", "?"),
 ])
 
 
@@ -70,14 +81,21 @@ def _centres_at(run, t: np.ndarray, idx: np.ndarray) -> np.ndarray:
     return out
 
 
-def impact_events(run, min_speed: float = DEFAULT_MIN_SPEED) -> tuple[np.ndarray, dict[str, Any]]:
+def impact_events(run, min_speed: float = DEFAULT_MIN_SPEED,
+                  min_force: float = math.inf) -> tuple[np.ndarray, dict[str, Any]]:
     """The impact events of a :class:`~demfem.studies.table_run.TableRun` with a normal
-    speed ≥ ``min_speed`` (m/s, ≥ 0), sphere–sphere and sphere–wall (not the belt), in time
-    order, as an array of :data:`EVENT_DTYPE`; and a summary: ``n_onsets`` (all recorded
-    onsets, belt contacts included), ``n_events`` (of which ``n_wall_events``, and per wall
-    ``wall_events``), ``n_dropped``, ``max_dropped_speed_m_per_s``, ``min_speed_m_per_s``,
+    speed ≥ ``min_speed`` (m/s, ≥ 0) or, for measured contacts, a peak normal force ≥
+    ``min_force`` (N, ≥ 0; default: no such rescue), sphere–sphere and sphere–wall (not the
+    belt), in time order, as an array of :data:`EVENT_DTYPE`; and a summary: ``n_onsets``
+    (all recorded onsets, belt contacts included), ``n_events`` (of which ``n_wall_events``,
+    and per wall ``wall_events``), ``n_dropped``, ``max_dropped_speed_m_per_s``,
+    ``min_speed_m_per_s``, ``measured`` (forces and durations measured in the DEM),
     ``partners_recorded``, ``note``."""
     v_min = check_range("min_speed", min_speed, 0.0, math.inf, lo_open=False)
+    f_min = math.inf if min_force == math.inf else check_range(
+        "min_force", min_force, 0.0, math.inf, lo_open=False)
+    if run.info.get("events_recorded"):
+        return _measured_events(run, v_min, f_min)
     o = run.onsets
     keep = np.asarray(o["normal_speed"], float) >= v_min
     sel = o[keep]
@@ -85,6 +103,7 @@ def impact_events(run, min_speed: float = DEFAULT_MIN_SPEED) -> tuple[np.ndarray
     for k in ("i", "j", "time", "normal_speed", "tangential_speed", "impact_angle"):
         ev[k] = sel[k]
     ev["partner"], ev["wall"] = 0, -1
+    ev["peak_force"] = ev["duration"] = ev["impulse"] = np.nan
     if len(sel):
         t = np.asarray(sel["time"], float)
         ci = _centres_at(run, t, np.asarray(sel["i"]))
@@ -109,6 +128,7 @@ def impact_events(run, min_speed: float = DEFAULT_MIN_SPEED) -> tuple[np.ndarray
               "x", "y", "z"):
         wev[k] = ws[k]
     wev["j"], wev["partner"] = -1, 1
+    wev["peak_force"] = wev["duration"] = wev["impulse"] = np.nan
     ev = np.concatenate([ev, wev])
     ev = ev[np.argsort(ev["time"], kind="stable")]
     dropped = np.concatenate([np.asarray(o["normal_speed"], float)[~keep],
@@ -116,18 +136,57 @@ def impact_events(run, min_speed: float = DEFAULT_MIN_SPEED) -> tuple[np.ndarray
     per_wall = {n: int(np.sum(ws["wall"] == k)) for k, n in enumerate(names)
                 if n not in NOT_IMPACTS}
     n_belt = int(len(w) - impact_wall.sum())
-    summary = {"n_onsets": int(len(o) + len(w)), "n_events": int(len(ev)),
-               "n_wall_events": int(len(wev)), "wall_events": per_wall,
-               "n_belt_contacts": n_belt,
-               "n_dropped": int(len(dropped)),
-               "max_dropped_speed_m_per_s": float(dropped.max()) if len(dropped) else 0.0,
-               "min_speed_m_per_s": v_min,
-               "partners_recorded": ["sphere", "wall"] if names else ["sphere"],
-               "note": (f"sphere-sphere and sphere-wall impacts (walls: "
-                        f"{', '.join(per_wall) or 'none recorded'}); the {n_belt} onsets on the "
-                        "belt are cartridges standing on their base, not side impacts, and "
-                        "are not events")}
-    return ev, summary
+    return ev, _summary(len(o) + len(w), ev, int(len(wev)), per_wall, n_belt, dropped, v_min,
+                        names, measured=False)
+
+
+def _summary(n_onsets: int, ev: np.ndarray, n_wall: int, per_wall: dict[str, int], n_belt: int,
+             dropped: np.ndarray, v_min: float, names: list[str], measured: bool
+             ) -> dict[str, Any]:
+    return {"n_onsets": int(n_onsets), "n_events": int(len(ev)),
+            "n_wall_events": n_wall, "wall_events": per_wall,
+            "n_belt_contacts": n_belt,
+            "n_dropped": int(len(dropped)),
+            "max_dropped_speed_m_per_s": float(dropped.max()) if len(dropped) else 0.0,
+            "min_speed_m_per_s": v_min, "measured": measured,
+            "partners_recorded": ["sphere", "wall"] if names else ["sphere"],
+            "note": (f"sphere-sphere and sphere-wall impacts (walls: "
+                     f"{', '.join(per_wall) or 'none recorded'}); the {n_belt} contacts with "
+                     "the belt are cartridges standing on their base, not side impacts, and "
+                     "are not events"
+                     + ("; peak force, duration and impulse measured in the DEM" if measured
+                        else "; force and duration from the calibrated law at onset speed"))}
+
+
+def _measured_events(run, v_min: float, f_min: float) -> tuple[np.ndarray, dict[str, Any]]:
+    """:func:`impact_events` from the run's measured whole contacts."""
+    c = np.asarray(run.contact_events)
+    names = [str(n) for n in run.info.get("wall_names", [])]
+    wall = c["partner_is_wall"]
+    n_walls = max(len(names), int(c["j"][wall].max()) + 1 if wall.any() else 0)
+    impact_by_wall = np.array([k >= len(names) or names[k] not in NOT_IMPACTS
+                               for k in range(n_walls)], bool)
+    impact = ~wall | impact_by_wall[np.where(wall, c["j"], 0)] if n_walls else ~wall
+    hard = (c["normal_speed"] >= v_min) | (c["peak_normal_force"] >= f_min)
+    sel = c[impact & hard]
+    ev = np.zeros(len(sel), EVENT_DTYPE)
+    ev["i"], ev["time"] = sel["i"], sel["time"]
+    w = sel["partner_is_wall"]
+    ev["j"] = np.where(w, -1, sel["j"])
+    ev["wall"] = np.where(w, sel["j"], -1)
+    ev["partner"] = w.astype(np.int64)
+    for k in ("x", "y", "z", "normal_speed", "tangential_speed"):
+        ev[k] = sel[k]
+    ev["impact_angle"] = np.arctan2(sel["tangential_speed"], sel["normal_speed"])
+    ev["peak_force"], ev["duration"] = sel["peak_normal_force"], sel["duration"]
+    ev["impulse"], ev["measured"] = sel["normal_impulse"], True
+    ev = ev[np.argsort(ev["time"], kind="stable")]
+    dropped = c["normal_speed"][impact & ~hard]
+    per_wall = {n: int(np.sum(w & (sel["j"] == k))) for k, n in enumerate(names)
+                if n not in NOT_IMPACTS}
+    n_belt = int(np.sum(wall & ~impact))
+    return ev, _summary(len(c), ev, int(w.sum()), per_wall, n_belt, dropped, v_min, names,
+                        measured=True)
 
 
 def events_of_cartridge(events: np.ndarray, cartridge: int) -> np.ndarray:

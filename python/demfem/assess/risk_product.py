@@ -15,19 +15,35 @@ from demfem.assess.risk_stage import (cartridge_risk, event_hazard, event_probab
 __all__ = ["risk_document"]
 
 
-def _basis(model, scg, ev_summary: dict[str, Any], e_stress: float, table) -> list[str]:
+def _basis(model, scg, ev_summary: dict[str, Any], e_stress: float, table,
+           stress: dict[str, np.ndarray]) -> list[str]:
     from demfem.risk import INNER_SURFACE, OUTER_SURFACE
 
+    measured = ev_summary.get("measured") and math.isclose(float(table.young_modulus), e_stress,
+                                                           rel_tol=1e-12)
+    if measured:
+        law = stress["law_force_N"]
+        ok = law > 0
+        ratio = (float(np.median(stress["force_N"][ok] / law[ok])) if ok.any() else math.nan)
+        force_line = (
+            "Peak force: measured in the DEM, the largest normal force of each contact over "
+            "the steps it lasted (the table's damping and the queue's pressure included); its "
+            "duration is that of the half-sine with the measured peak and impulse, "
+            "(pi/2) J / F_max. The median ratio of the measured peak to the calibrated "
+            f"Hertz-Reissner law's at the onset speed is {ratio:.3g}.")
+    else:
+        force_line = (
+            "Peak force: the calibrated Hertz-Reissner law (paper eq. 12, demfem.contact."
+            f"max_contact_force) at E = {e_stress:.3g} Pa for the default 3 mL cartridge's "
+            "equivalent body; the DEM's restitution (damping) is not applied to the peak "
+            "(undamped, an upper bound).")
     lines = [
         "Impact speeds: the DEM of the table (equivalent spheres, Hertz-Reissner-Mindlin "
         f"contacts, E = {table.young_modulus:.3g} Pa); every contact onset with normal speed "
         f">= {ev_summary['min_speed_m_per_s']:g} m/s is an event "
         f"({ev_summary['n_dropped']} slower onsets dropped, the fastest of them at "
         f"{ev_summary['max_dropped_speed_m_per_s']:.3g} m/s). {ev_summary['note']}.",
-        "Peak force: the calibrated Hertz-Reissner law (paper eq. 12, demfem.contact."
-        f"max_contact_force) at E = {e_stress:.3g} Pa for the default 3 mL cartridge's "
-        "equivalent body; the DEM's restitution (damping) is not applied to the peak "
-        "(undamped, an upper bound).",
+        force_line,
         f"Stress model: sigma1 = beta F/t^2 with beta_inner = {model.beta_inner:.4g}, "
         f"beta_outer = {model.beta_outer:.4g}, t = {model.thickness:g} m; stressed areas "
         f"{model.area_factor_inner:.4g} (inner) and {model.area_factor_outer:.4g} (outer) "
@@ -112,6 +128,8 @@ def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[st
                        if h_all > 0 else math.nan),
         "wall_share_by_wall": by_wall,
         "max_force_N": mx(stress["force_N"][inside]),
+        "forces_measured": bool(ev_summary.get("measured")) and math.isclose(
+            float(table.young_modulus), e_stress, rel_tol=1e-12),
         "max_sigma_inner_Pa": mx(stress["sigma_inner_Pa"][inside]),
         "max_sigma_outer_Pa": mx(stress["sigma_outer_Pa"][inside]),
     }
@@ -130,13 +148,14 @@ def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[st
                         "gate period of the default table): a smoke run, not an assessment.")
     doc = {"format": 1, "summary": summary, "steady_state": steady, "worst_events": worst,
            "events": ev_summary, "warnings": warnings,
-           "basis": _basis(model, scg, ev_summary, e_stress, table),
+           "basis": _basis(model, scg, ev_summary, e_stress, table, stress),
            "window_s": list(window), "settings": settings,
            "settings_flat": {k: v for k, v in _flatten(settings).items()
                              if not k.startswith("stress_model.units")}}
     files = [write_json_atomic(out / "risk.json", doc)]
     extra = {"force_N": stress["force_N"], "contact_radius_m": stress["contact_radius_m"],
-             "duration_s": stress["duration_s"], "sigma_inner_Pa": stress["sigma_inner_Pa"],
+             "duration_s": stress["duration_s"], "law_force_N": stress["law_force_N"],
+             "sigma_inner_Pa": stress["sigma_inner_Pa"],
              "sigma_outer_Pa": stress["sigma_outer_Pa"],
              "area_inner_m2": stress["area_inner_m2"], "area_outer_m2": stress["area_outer_m2"],
              "p_inner": p["p_inner"], "p_outer": p["p_outer"], "p_event": p["p_event"],

@@ -136,7 +136,7 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
                 "slow_crack_growth": dataclasses.asdict(scg) if scg else None,
                 "inner_surface": dataclasses.asdict(INNER_SURFACE),
                 "outer_surface": dataclasses.asdict(OUTER_SURFACE),
-                "dem_model": "hertz_reissner_mindlin"}
+                "dem_model": "hertz_reissner_mindlin", "dem_events": "measured"}
     out = Path(out)
     from demfem.studies.table_run import remove_checkpoint
 
@@ -196,7 +196,8 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
         try:
             run = run_table(table, duration, sample_interval, threads=threads,
                             progress=bar, checkpoint=out / "table.ck",
-                            checkpoint_every=checkpoint_every, fresh=fresh)
+                            checkpoint_every=checkpoint_every, fresh=fresh,
+                            record_events=True)
         finally:
             if bar is not None:
                 bar.close()
@@ -216,7 +217,12 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
     done = book.is_done("events")
     header(3, f"impact events (normal speed >= {v_min:g} m/s)", done)
     if not done:
-        events, ev_summary = impact_events(run, v_min)
+        # a contact that began below the minimum speed is kept if the DEM measured a peak
+        # force at least that of an impact at the minimum speed
+        f_min = float(ImpactLaw(cartridge_body(e_stress, table.poisson_ratio),
+                                cartridge_body(e_stress, table.poisson_ratio)).force(
+            np.array([v_min]))[0]) if v_min > 0 else 0.0
+        events, ev_summary = impact_events(run, v_min, f_min)
         _save_npz(ev_path, events=events, summary=np.array(json.dumps(ev_summary)))
         book.complete("events", [ev_path])
     data = _load_npz(ev_path)
@@ -234,9 +240,18 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
     st_path = out / "stress.npz"
     done = book.is_done("stress")
     header(4, "force, duration, sigma1 and stressed area per event", done)
+    # measured forces hold at the DEM's modulus only
+    use_measured = bool(ev_summary.get("measured")) and math.isclose(
+        float(table.young_modulus), e_stress, rel_tol=1e-12)
+    log("  forces: " + ("measured in the DEM (peak of each contact; duration from its impulse)"
+                        if use_measured else "calibrated law at the onset speed"
+                        + (f" (the DEM ran at E = {table.young_modulus:.3g} Pa, the stresses "
+                           f"are at {e_stress:.3g} Pa)" if ev_summary.get("measured") else "")))
     if not done:
-        stress = collision_stresses(events["normal_speed"], events["partner"], model,
-                                    e_stress, table.poisson_ratio)
+        stress = collision_stresses(
+            events["normal_speed"], events["partner"], model, e_stress, table.poisson_ratio,
+            measured_force=events["peak_force"] if use_measured else None,
+            measured_impulse=events["impulse"] if use_measured else None)
         _save_npz(st_path, **stress)
         book.complete("stress", [st_path])
     stress = _load_npz(st_path)

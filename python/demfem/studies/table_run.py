@@ -27,6 +27,7 @@ from typing import Any, Callable, Mapping, Optional
 import numpy as np
 
 from demfem.analysis.collisions import ONSET_DTYPE, WALL_ONSET_DTYPE
+from demfem.analysis.contact_events import CONTACT_EVENT_DTYPE, contact_event_table
 from demfem.analysis.forces import first_line_force, force_statistics
 from demfem.analysis.coordination import mean_coordination
 from demfem.errors import (CheckpointError, DemfemIOError, InvalidParameterError,
@@ -74,6 +75,11 @@ class TableRun:
         wall_onsets: sphere-wall contact onsets (belt, side walls, tilted wall, gate),
             :data:`demfem.analysis.collisions.WALL_ONSET_DTYPE`; empty for runs saved before
             they were recorded.
+        contact_events: whole contacts (sphere-sphere and sphere-wall) with their measured
+            duration, peak forces and impulse,
+            :data:`demfem.analysis.contact_events.CONTACT_EVENT_DTYPE`; recorded when the run
+            asks (``run_table(record_events=True)``, ``info["events_recorded"]``), else empty.
+            Contacts still open at the end are in it with ``complete`` False.
     """
 
     parameters: dict[str, Any]
@@ -92,6 +98,8 @@ class TableRun:
     onsets: np.ndarray
     info: dict[str, Any] = field(default_factory=dict)
     wall_onsets: np.ndarray = field(default_factory=lambda: np.zeros(0, WALL_ONSET_DTYPE))
+    contact_events: np.ndarray = field(
+        default_factory=lambda: np.zeros(0, CONTACT_EVENT_DTYPE))
 
     @property
     def n_frames(self) -> int:
@@ -144,7 +152,8 @@ class TableRun:
         """Write the run to ``path`` (``.npz``) atomically; returns the path."""
         arrays = {name: getattr(self, name) for name in _ARRAYS}
         arrays.update(tags=self.tags, radii=self.radii, removal_times=self.removal_times,
-                      onsets=self.onsets, wall_onsets=self.wall_onsets)
+                      onsets=self.onsets, wall_onsets=self.wall_onsets,
+                      contact_events=self.contact_events)
         document = json_dumps({"parameters": self.parameters, "info": self.info})
         target = Path(path)
         with atomic_path(target, suffix=".npz") as tmp:
@@ -171,6 +180,8 @@ class TableRun:
                                         + ", ".join(missing))
         if "wall_onsets" not in arrays:  # a run saved before wall onsets were recorded
             arrays["wall_onsets"] = np.zeros(0, WALL_ONSET_DTYPE)
+        if "contact_events" not in arrays:  # a run saved before events were recorded
+            arrays["contact_events"] = np.zeros(0, CONTACT_EVENT_DTYPE)
         return cls(parameters=document["parameters"], info=document["info"], **arrays)
 
     def summary(self, discard_before: float = 0.0, quantile: float = 0.95) -> dict[str, float]:
@@ -217,6 +228,7 @@ class _Recorder:
         self.frames: dict[str, list[np.ndarray]] = {k: [] for k in _ARRAYS}
         self.onset_parts: list[dict[str, np.ndarray]] = []
         self.wall_parts: list[dict[str, np.ndarray]] = []
+        self.event_parts: list[dict[str, np.ndarray]] = []
         self.removal_times = np.full(n, np.nan)
 
     def sample(self, sim, table: AccumulationTable) -> None:
@@ -241,8 +253,11 @@ class _Recorder:
         f["max_overlap"].append(np.array(float(sim.max_overlap())))
         f["kinetic_energy"].append(np.array(float(sim.kinetic_energy())))
 
-    def collect_events(self, sim) -> None:
-        """Move the engine's onset log and removals into the record (and clear the log)."""
+    def collect_events(self, sim, contact_events: bool = False) -> None:
+        """Move the engine's onset log, removals and (``contact_events``) whole-contact
+        events into the record (and clear the logs)."""
+        if contact_events:
+            self.event_parts.append(_event_columns(sim.events()))
         o = sim.onsets()
         wall = np.asarray(o["partner_is_wall"], bool)
         for keep, parts in ((~wall, self.onset_parts), (wall, self.wall_parts)):
@@ -301,8 +316,29 @@ class _Recorder:
             table["coordination_j"] = _coordination_at(coordination, frame, raw["j"])
         return table[np.argsort(table["time"], kind="stable")]
 
+    def raw_events(self, open_now: Optional[dict[str, np.ndarray]] = None
+                   ) -> dict[str, np.ndarray]:
+        """The recorded event columns, and those of ``open_now`` (the contacts open at the
+        end), concatenated."""
+        parts = self.event_parts + ([open_now] if open_now is not None else [])
+        if not parts:
+            return _event_columns(None)
+        return {k: np.concatenate([p[k] for p in parts]) for k in _EVENT_COLUMNS}
+
+    def event_table(self, times: np.ndarray, coordination: np.ndarray, radii: np.ndarray,
+                    open_now: dict[str, np.ndarray]) -> np.ndarray:
+        table = contact_event_table(self.raw_events(open_now), radii)
+        if len(table):
+            frame = _nearest_frame(times, table["time"])
+            table["coordination_i"] = _coordination_at(coordination, frame, table["i"])
+            sphere = ~table["partner_is_wall"]
+            table["coordination_j"][sphere] = _coordination_at(coordination, frame[sphere],
+                                                               table["j"][sphere])
+        return table
+
     def save_partial(self, path: Path) -> None:
         arrays: dict[str, Any] = {f"frame_{k}": v for k, v in self.stacked().items()}
+        arrays.update({f"event_{k}": v for k, v in self.raw_events().items()})
         arrays.update({f"onset_{k}": v for k, v in self.raw_onsets().items()})
         arrays.update({f"wall_onset_{k}": v for k, v in self.raw_onsets(walls=True).items()})
         arrays["removal_times"] = self.removal_times
@@ -320,7 +356,27 @@ class _Recorder:
                 self.wall_parts = [{k: data[f"wall_onset_{k}"] for k in
                                     ("i", "j", "time", "normal_speed", "tangential_speed",
                                      "point")}]
+            if "event_time" in data.files:
+                self.event_parts = [{k: data[f"event_{k}"] for k in _EVENT_COLUMNS}]
             self.removal_times = np.array(data["removal_times"], float)
+
+
+#: The engine's event columns (:meth:`demfem._core.DemSimulation.events`).
+_EVENT_COLUMNS = ("time", "duration", "particle", "partner", "partner_is_wall", "normal_speed",
+                  "tangential_speed", "position", "partner_position", "peak_normal_force",
+                  "normal_impulse", "peak_tangential_force", "max_overlap", "complete")
+
+
+def _event_columns(raw: Optional[Mapping[str, Any]]) -> dict[str, np.ndarray]:
+    """The engine's event dict as plain arrays (an empty table for ``None``)."""
+    kinds = {"particle": np.int64, "partner": np.int64, "partner_is_wall": bool,
+             "complete": bool}
+    out = {}
+    for k in _EVENT_COLUMNS:
+        value = np.zeros(0) if raw is None else raw[k]
+        a = np.asarray(value, kinds.get(k, float))
+        out[k] = a.reshape(-1, 3) if k in ("position", "partner_position") else a
+    return out
 
 
 def _coordination_at(coordination: np.ndarray, frame: np.ndarray,
@@ -355,15 +411,19 @@ def check_run_arguments(duration: float, sample_interval: float, threads: int) -
 
 
 def run_settings(table: AccumulationTable, duration: float, sample_interval: float,
-                 model: str, dt: Optional[float]) -> dict[str, Any]:
+                 model: str, dt: Optional[float], record_events: bool = False) -> dict[str, Any]:
     """What makes a run's result: the table's fields, ``duration_s``, ``sample_interval_s``,
-    ``model`` and the requested ``dt_s`` (None: the engine's safe step). Threads are not in
-    it: results are bitwise the same on any number. Strict-JSON values."""
+    ``model``, the requested ``dt_s`` (None: the engine's safe step) and, when on,
+    ``record_events``. Threads are not in it: results are bitwise the same on any number.
+    Strict-JSON values."""
     from demfem.io.strict_json import finite_or_none
 
-    return finite_or_none({"scene": dataclasses.asdict(table), "duration_s": float(duration),
-                           "sample_interval_s": float(sample_interval), "model": model,
-                           "dt_s": None if dt is None else float(dt)})
+    settings = {"scene": dataclasses.asdict(table), "duration_s": float(duration),
+                "sample_interval_s": float(sample_interval), "model": model,
+                "dt_s": None if dt is None else float(dt)}
+    if record_events:
+        settings["record_events"] = True
+    return finite_or_none(settings)
 
 
 def settings_differences(recorded: Mapping[str, Any], now: Mapping[str, Any],
@@ -397,7 +457,7 @@ def run_table(table: AccumulationTable, duration: float, sample_interval: float 
               progress: Optional[Callable[[float, int], None]] = None,
               checkpoint: Optional[str | Path] = None, checkpoint_every: float = 300.0,
               dt: Optional[float] = None, fresh: bool = False,
-              overlap_fraction: float = 0.1) -> TableRun:
+              overlap_fraction: float = 0.1, record_events: bool = False) -> TableRun:
     """Run ``table`` for ``duration`` s of simulated time and sample it every
     ``sample_interval`` s (samples at 0, Δ, 2Δ, ... up to ``duration``).
 
@@ -422,6 +482,10 @@ def run_table(table: AccumulationTable, duration: float, sample_interval: float 
         overlap_fraction: physical sanity check at every sample: a sphere sunk into the belt
             or an overlap deeper than this fraction of the radius raises
             :class:`demfem.errors.NumericalError` (see :func:`demfem.dem.check_state`).
+        record_events: also record every whole contact with its measured duration, peak
+            forces and impulse (:attr:`TableRun.contact_events`); the engine then writes
+            every contact's normal force on every step (about 1.3x the step's time on the
+            default table, ``benches/dem_events_cost.py``).
 
     Returns:
         The :class:`TableRun`.
@@ -436,12 +500,13 @@ def run_table(table: AccumulationTable, duration: float, sample_interval: float 
                                     "be a finite number of seconds > 0")
     scene = table.build()
     belt = _belt_plane(scene)
-    sim = from_scene(scene, model=model, threads=threads, record_onsets=True, dt=dt)
+    sim = from_scene(scene, model=model, threads=threads, record_onsets=True, dt=dt,
+                     record_events=record_events)
     n_samples = int(math.floor(duration / sample_interval + 1e-9))
     sample_times = sample_interval * np.arange(n_samples + 1)
     rec = _Recorder(len(scene.radii))
     wall_before = 0.0
-    settings = run_settings(table, duration, sample_interval, model, dt)
+    settings = run_settings(table, duration, sample_interval, model, dt, record_events)
     ckpt = Path(checkpoint) if checkpoint is not None else None
     files = checkpoint_files(ckpt) if ckpt is not None else None
     if ckpt is not None and fresh:
@@ -458,7 +523,7 @@ def run_table(table: AccumulationTable, duration: float, sample_interval: float 
         sim.run_until(float(sample_times[k]))
         if scene.refeed is not None:
             refeed_removed(sim, scene.refeed["sites"], scene.refeed["velocity"])
-        rec.collect_events(sim)
+        rec.collect_events(sim, record_events)
         rec.sample(sim, table)
         check_state(sim, floor=belt, overlap_fraction=overlap_fraction)
         k += 1
@@ -476,7 +541,11 @@ def run_table(table: AccumulationTable, duration: float, sample_interval: float 
         removal_times=rec.removal_times,
         onsets=rec.onset_table(frames["times"], frames["coordination"]),
         wall_onsets=rec.wall_onset_table(frames["times"], frames["coordination"]),
-        info={"model": model, "dt": float(sim.dt), "effects": list(scene.effects),
+        contact_events=(rec.event_table(frames["times"], frames["coordination"],
+                                        np.asarray(scene.radii, float),
+                                        _event_columns(sim.open_events()))
+                        if record_events else np.zeros(0, CONTACT_EVENT_DTYPE)),
+        info={"model": model, "events_recorded": bool(record_events), "dt": float(sim.dt), "effects": list(scene.effects),
               "wall_names": [str(w["name"]) for w in scene.walls],
               "steps": int(sim.steps), "threads": int(threads),
               "sample_interval": float(sample_interval), "duration": float(duration),

@@ -214,7 +214,7 @@ impl DemSimulation {
         material_ids=None, tags=None, gravity=(0.0, 0.0, -9.81), model="hertz_mindlin",
         linear_stiffness=None, clamp_normal_force=true, dt=None, dt_safety=0.2,
         expected_max_speed=1.0, skin=None, threads=1, overlap_tolerance=0.01, record_every=0,
-        record_onsets=false, removal_plane=None
+        record_onsets=false, removal_plane=None, record_events=false
     ))]
     #[allow(clippy::too_many_arguments)]
     fn new(
@@ -241,6 +241,7 @@ impl DemSimulation {
         record_every: i64,
         record_onsets: bool,
         removal_plane: Option<((f64, f64, f64), (f64, f64, f64))>,
+        record_events: bool,
     ) -> PyResult<Self> {
         if threads < 1 {
             return Err(invalid(
@@ -365,6 +366,7 @@ impl DemSimulation {
         scene.initial_overlap_tolerance = overlap_tolerance;
         scene.record_every = record_every;
         scene.record_onsets = record_onsets;
+        scene.record_events = record_events;
         scene.removal_plane =
             removal_plane.map(|(p, n)| (Vec3::new(p.0, p.1, p.2), Vec3::new(n.0, n.1, n.2)));
         let sim = py
@@ -698,7 +700,20 @@ impl DemSimulation {
         Ok(d)
     }
 
-    /// Drop recorded frames and onsets.
+    /// Every whole contact that ended (recorded with `record_events=True`): see
+    /// `demfem.dem` for the columns (time, duration, particle, partner, partner_is_wall,
+    /// onset speeds, positions, peak_normal_force, normal_impulse, peak_tangential_force,
+    /// max_overlap, complete), SI units.
+    fn events<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        crate::dem_events::event_columns(py, self.sim.events())
+    }
+
+    /// The contacts open now, as events so far (`complete` False); the log is unchanged.
+    fn open_events<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        crate::dem_events::event_columns(py, &self.sim.open_events())
+    }
+
+    /// Drop recorded frames, onsets and events.
     fn clear_records(&mut self) {
         self.sim.clear_records();
     }
@@ -753,7 +768,7 @@ impl DemSimulation {
 impl DemSimulation {}
 
 /// The `partner` (index) and `partner_is_wall` columns of an onset or contact table.
-fn set_partner_columns(
+pub(crate) fn set_partner_columns(
     py: Python<'_>,
     d: &Bound<'_, PyDict>,
     partners: impl Iterator<Item = Partner>,

@@ -10,6 +10,7 @@ use demfem::contact::{self, ForceClamp, NormalLaw};
 use demfem::DemfemError;
 
 mod dem;
+mod dem_events;
 mod dem_walls;
 mod fem;
 mod fem_contact;

@@ -5,20 +5,23 @@
 //!
 //! The static scene (particles' radii, materials, walls, effects, dt) is not stored; a
 //! fingerprint of it is, and loading into a simulation whose scene differs is refused.
-//! Records (frames, onsets) are outputs and are not stored.
+//! Records (frames, onsets, logged events) are outputs and are not stored; the accumulators
+//! of the contacts still open are (version 3), so a resumed run logs the same events.
 //!
 //! Files are written atomically: to `<path>.tmp`, fsync, rename over `<path>`.
 
 use std::io::Write;
 use std::path::Path;
 
-use crate::dem::simulation::{PairContact, Simulation, WallContact};
+use crate::dem::simulation::{EventAcc, PairContact, Simulation, WallContact};
 use crate::error::{DemfemError, Result};
 use crate::geometry::Vec3;
 
 const MAGIC: &[u8; 8] = b"DEMFEMCK";
 /// Version of the checkpoint format.
-pub const CHECKPOINT_VERSION: u32 = 2;
+pub const CHECKPOINT_VERSION: u32 = 3;
+/// The oldest version this build still reads (version 2: no event accumulators).
+const OLDEST_VERSION: u32 = 2;
 
 struct Writer(Vec<u8>);
 impl Writer {
@@ -38,6 +41,22 @@ impl Writer {
         self.f64(v.x);
         self.f64(v.y);
         self.f64(v.z);
+    }
+    fn event(&mut self, a: &EventAcc) {
+        self.u8(a.open as u8);
+        self.u64(a.start_step);
+        for v in [
+            a.normal_speed,
+            a.tangential_speed,
+            a.peak_normal_force,
+            a.normal_impulse,
+            a.peak_tangential_force,
+            a.max_overlap,
+        ] {
+            self.f64(v);
+        }
+        self.vec3(a.position);
+        self.vec3(a.partner_position);
     }
 }
 
@@ -76,6 +95,20 @@ impl Reader<'_> {
     }
     fn vec3(&mut self) -> Result<Vec3> {
         Ok(Vec3::new(self.f64()?, self.f64()?, self.f64()?))
+    }
+    fn event(&mut self) -> Result<EventAcc> {
+        Ok(EventAcc {
+            open: self.u8()? != 0,
+            start_step: self.u64()?,
+            normal_speed: self.f64()?,
+            tangential_speed: self.f64()?,
+            peak_normal_force: self.f64()?,
+            normal_impulse: self.f64()?,
+            peak_tangential_force: self.f64()?,
+            max_overlap: self.f64()?,
+            position: self.vec3()?,
+            partner_position: self.vec3()?,
+        })
     }
     fn count(&mut self, max: usize, what: &str) -> Result<usize> {
         let n = self.u64()?;
@@ -168,6 +201,12 @@ impl Simulation {
             w.u8(s.active as u8);
             w.vec3(s.history);
         }
+        w.u8(self.record_events as u8);
+        if self.record_events {
+            for a in self.pair_event.iter().chain(&self.wall_event) {
+                w.event(a);
+            }
+        }
         w.0
     }
 
@@ -210,9 +249,10 @@ impl Simulation {
             return Err(bad("not a demfem checkpoint (bad magic)".into()));
         }
         let version = r.u32()?;
-        if version != CHECKPOINT_VERSION {
+        if !(OLDEST_VERSION..=CHECKPOINT_VERSION).contains(&version) {
             return Err(bad(format!(
-                "checkpoint version {version}, this build reads {CHECKPOINT_VERSION}"
+                "checkpoint version {version}, this build reads {OLDEST_VERSION} to \
+                 {CHECKPOINT_VERSION}"
             )));
         }
         let fp = r.u64()?;
@@ -307,9 +347,34 @@ impl Simulation {
                 ..Default::default()
             });
         }
+        // version 3: the event accumulators, when the writing run recorded events
+        let saved_events = version >= 3 && r.u8()? != 0;
+        let mut accs = Vec::new();
+        if saved_events {
+            for _ in 0..n_pairs + n_slots {
+                accs.push(r.event()?);
+            }
+        }
         if r.at != data.len() {
             return Err(bad("trailing bytes after checkpoint".into()));
         }
+        let (pair_event, wall_event) = if !self.record_events {
+            (Vec::new(), Vec::new())
+        } else if saved_events {
+            let wall = accs.split_off(n_pairs);
+            (accs, wall)
+        } else {
+            // a checkpoint without events: the contacts open now start their events here
+            let open = |active: bool| EventAcc {
+                open: active,
+                start_step: steps,
+                ..Default::default()
+            };
+            (
+                pair_active.iter().map(|&a| open(a)).collect(),
+                slots.iter().map(|s| open(s.active)).collect(),
+            )
+        };
         self.time = time;
         self.steps = steps;
         self.rebuilds = rebuilds;
@@ -326,6 +391,8 @@ impl Simulation {
         self.pair_onset = pair_onset;
         self.wall_stride = stride;
         self.wall_slots = slots;
+        self.pair_event = pair_event;
+        self.wall_event = wall_event;
         self.build_gather_lists();
         self.refresh_contact_constants();
         self.refresh_wall_state();

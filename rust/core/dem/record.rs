@@ -78,3 +78,41 @@ pub struct ContactOnset {
     /// Centre of the partner particle, or the contact point on the wall, m.
     pub partner_position: Vec3,
 }
+
+/// One whole contact, from its first step to its last (recorded with
+/// [`Scene::record_events`](crate::dem::Scene::record_events)): the onset's speeds and
+/// positions with what the contact did while it lasted, measured step by step.
+///
+/// The force sums are those of the steps in contact: the impulse is Σ F_n Δt over the force
+/// evaluations with an overlap, the duration the time from the first such evaluation to the
+/// first without one (exact to one step, Δt).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactEvent {
+    /// Simulated time of the first force evaluation in contact, s.
+    pub time: f64,
+    /// Contact duration, s (to the end of the run for an open contact).
+    pub duration: f64,
+    /// The first particle (the lower index for particle pairs).
+    pub particle: u32,
+    /// The other body.
+    pub partner: Partner,
+    /// Normal approach speed at onset, m/s (> 0 approaching).
+    pub normal_speed: f64,
+    /// Tangential relative speed at the contact point at onset, m/s.
+    pub tangential_speed: f64,
+    /// Centre of the particle at onset, m.
+    pub position: Vec3,
+    /// Centre of the partner particle at onset, or the contact point on the wall, m.
+    pub partner_position: Vec3,
+    /// Largest normal force during the contact, N.
+    pub peak_normal_force: f64,
+    /// Normal impulse Σ F_n Δt, N·s.
+    pub normal_impulse: f64,
+    /// Largest tangential force magnitude during the contact, N.
+    pub peak_tangential_force: f64,
+    /// Largest overlap during the contact, m.
+    pub max_overlap: f64,
+    /// The contact ended within the run (false: still open when listed by
+    /// `Simulation::open_events`, or cut short by a particle's removal).
+    pub complete: bool,
+}

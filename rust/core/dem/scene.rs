@@ -83,6 +83,9 @@ pub struct Scene {
     pub record_every: u64,
     /// Log every contact onset.
     pub record_onsets: bool,
+    /// Log every whole contact, with its duration, peak forces and impulse measured step by
+    /// step ([`ContactEvent`](crate::dem::ContactEvent)); costs nothing when off.
+    pub record_events: bool,
     /// Outlet: a particle whose centre lies behind this plane (point, normal towards the
     /// kept side; m) is removed at the next neighbour-list rebuild (a particle leaving moves
     /// and soon triggers one). `None`: nothing is removed.
@@ -115,6 +118,7 @@ impl Scene {
             initial_overlap_tolerance: 0.01,
             record_every: 0,
             record_onsets: false,
+            record_events: false,
             removal_plane: None,
         }
     }

@@ -68,13 +68,14 @@
 use crate::dem::effects::{Effect, EffectSet};
 use crate::dem::material::{ContactModel, PairLaw};
 use crate::dem::neighbor::CellGrid;
-use crate::dem::record::{ContactOnset, Frame};
+use crate::dem::record::{ContactEvent, ContactOnset, Frame};
 use crate::geometry::{Vec3, Wall};
 use std::sync::atomic::AtomicU64;
 
 mod api;
 mod batch;
 mod blocks;
+mod events;
 mod gather;
 mod law;
 mod lists;
@@ -87,6 +88,7 @@ mod step;
 mod wall;
 
 use blocks::CutLists;
+pub(crate) use events::EventAcc;
 use law::ContactConst;
 use lists::WallLists;
 pub use stable::{stable_time_step, StableStep};
@@ -169,6 +171,8 @@ pub struct Simulation {
     pairs_uniform: Option<(u32, f64)>,
     pub(crate) record_every: u64,
     pub(crate) record_onsets: bool,
+    /// Log whole contacts ([`ContactEvent`]; see `events`).
+    pub(crate) record_events: bool,
     /// Outlet plane (point, unit normal towards the kept side).
     pub(crate) removal_plane: Option<(Vec3, Vec3)>,
     // ---- dynamic state (what a checkpoint holds)
@@ -183,6 +187,8 @@ pub struct Simulation {
     pub(crate) pair_active: Vec<bool>,
     /// Whether each pair's contact began at the last force evaluation.
     pub(crate) pair_onset: Vec<bool>,
+    /// Event accumulator of each pair (empty unless `record_events`).
+    pub(crate) pair_event: Vec<EventAcc>,
     /// Until when each pair out of contact cannot touch, in units of [`Simulation::travel`]
     /// (m): a pair last found a gap g apart when the travel was D cannot touch while the
     /// travel is below D + g/2 (less a rounding margin), because neither of its particles
@@ -211,6 +217,8 @@ pub struct Simulation {
     /// streaming through the caches every step.
     contact_table: Vec<ContactConst>,
     pub(crate) wall_slots: Vec<WallContact>,
+    /// Event accumulator of each wall slot (empty unless `record_events`).
+    pub(crate) wall_event: Vec<EventAcc>,
     wall_out: Vec<WallOut>,
     wall_detail: Vec<WallDetail>,
     /// This step writes the record-only values (the last step of a [`Simulation::step`] call).
@@ -250,7 +258,9 @@ pub struct Simulation {
     old_pairs: Vec<PairContact>,
     old_pair_active: Vec<bool>,
     old_pair_onset: Vec<bool>,
+    old_pair_event: Vec<EventAcc>,
     old_slots: Vec<WallContact>,
+    old_wall_event: Vec<EventAcc>,
     wall_state: Vec<WallState>,
     /// Contacts begun and ended in each chunk of `PAIR_CHUNK` pairs at the last force
     /// evaluation.
@@ -275,6 +285,7 @@ pub struct Simulation {
     // ---- records
     pub(crate) frames: Vec<Frame>,
     pub(crate) onsets: Vec<ContactOnset>,
+    pub(crate) events: Vec<ContactEvent>,
     pub(crate) rebuilds: u64,
     /// (time, particle) of every removal through the outlet plane.
     pub(crate) removals: Vec<(f64, u32)>,

@@ -120,6 +120,7 @@ impl Simulation {
             pairs_uniform: None,
             record_every: scene.record_every,
             record_onsets: scene.record_onsets,
+            record_events: scene.record_events,
             removal_plane: scene.removal_plane.map(|(p, n)| (p, n / n.length())),
             position: p.position.clone(),
             velocity: p.velocity.clone(),
@@ -130,6 +131,7 @@ impl Simulation {
             pairs: Vec::new(),
             pair_active: Vec::new(),
             pair_onset: Vec::new(),
+            pair_event: Vec::new(),
             pair_wake: Vec::new(),
             travel: 0.0,
             travel_slack: 0.0,
@@ -142,6 +144,7 @@ impl Simulation {
             pair_const: Vec::new(),
             contact_table: Vec::new(),
             wall_slots: Vec::new(),
+            wall_event: Vec::new(),
             wall_out: Vec::new(),
             wall_detail: Vec::new(),
             detail: true,
@@ -161,7 +164,9 @@ impl Simulation {
             old_pairs: Vec::new(),
             old_pair_active: Vec::new(),
             old_pair_onset: Vec::new(),
+            old_pair_event: Vec::new(),
             old_slots: Vec::new(),
+            old_wall_event: Vec::new(),
             wall_state: vec![WallState::default(); scene.walls.len()],
             chunk_flips: Vec::new(),
             chunk_results: Vec::new(),
@@ -175,6 +180,7 @@ impl Simulation {
             pool,
             frames: Vec::new(),
             onsets: Vec::new(),
+            events: Vec::new(),
             rebuilds: 0,
             removals: Vec::new(),
         };
@@ -229,7 +235,7 @@ impl Simulation {
             Some(pool) if self.position.len() >= PARALLEL_MIN_PARTICLES => {
                 let r = pool.install(|| {
                     for k in 0..n {
-                        self.detail = k + 1 == n || self.frame_due_next();
+                        self.detail = self.record_events || k + 1 == n || self.frame_due_next();
                         self.one_step(true)?;
                     }
                     Ok(())
@@ -240,7 +246,7 @@ impl Simulation {
             other => {
                 self.pool = other;
                 for k in 0..n {
-                    self.detail = k + 1 == n || self.frame_due_next();
+                    self.detail = self.record_events || k + 1 == n || self.frame_due_next();
                     self.one_step(false)?;
                 }
                 Ok(())
@@ -452,10 +458,11 @@ impl Simulation {
     pub fn onsets(&self) -> &[ContactOnset] {
         &self.onsets
     }
-    /// Drop the recorded frames and onsets (e.g. after copying them out).
+    /// Drop the recorded frames, onsets and events (e.g. after copying them out).
     pub fn clear_records(&mut self) {
         self.frames.clear();
         self.onsets.clear();
+        self.events.clear();
     }
     /// Effects the step runs.
     pub fn effects(&self) -> EffectSet {

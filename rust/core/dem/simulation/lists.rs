@@ -4,10 +4,12 @@
 //! each force phase, the contact constants, and the wall slots of the batched kernels
 //! ([`WallLists`]).
 
+use super::events::EventAcc;
 use super::law::{ContactConst, LawKind};
 use super::state::{PairContact, PairDetail, PairOut, WallContact, WallDetail, WallOut, WallState};
 use super::{Simulation, NO_WALL, PAIR_CHUNK};
 use crate::dem::effects::Effect;
+use crate::dem::record::Partner;
 use crate::geometry::{Vec3, WallShape};
 
 /// The wall slots the batched wall kernel evaluates, listed when the neighbour lists (or the
@@ -336,15 +338,23 @@ impl Simulation {
         std::mem::swap(&mut self.pairs, &mut self.old_pairs);
         std::mem::swap(&mut self.pair_active, &mut self.old_pair_active);
         std::mem::swap(&mut self.pair_onset, &mut self.old_pair_onset);
+        std::mem::swap(&mut self.pair_event, &mut self.old_pair_event);
         self.pairs.clear();
         self.pair_active.clear();
         self.pair_onset.clear();
+        self.pair_event.clear();
+        let events = self.record_events;
+        // open contacts of pairs the new list drops (a removed particle)
+        let mut dropped: Vec<usize> = Vec::new();
         let mut old = 0usize;
         for &(i, j) in &self.candidate_scratch {
             // both lists are sorted by (i, j): merge to carry the state of surviving pairs
             while old < self.old_pairs.len()
                 && (self.old_pairs[old].i, self.old_pairs[old].j) < (i, j)
             {
+                if events {
+                    dropped.push(old);
+                }
                 old += 1;
             }
             if old < self.old_pairs.len()
@@ -353,6 +363,10 @@ impl Simulation {
                 self.pairs.push(self.old_pairs[old]);
                 self.pair_active.push(self.old_pair_active[old]);
                 self.pair_onset.push(self.old_pair_onset[old]);
+                if events {
+                    self.pair_event.push(self.old_pair_event[old]);
+                }
+                old += 1;
             } else {
                 self.pairs.push(PairContact {
                     i,
@@ -361,6 +375,18 @@ impl Simulation {
                 });
                 self.pair_active.push(false);
                 self.pair_onset.push(false);
+                if events {
+                    self.pair_event.push(EventAcc::default());
+                }
+            }
+        }
+        if events {
+            dropped.extend(old..self.old_pairs.len());
+            for k in dropped {
+                let (p, acc) = (self.old_pairs[k], self.old_pair_event[k]);
+                if self.old_pair_active[k] {
+                    self.close_dropped(&acc, p.i, Partner::Particle(p.j));
+                }
             }
         }
         self.build_gather_lists();
@@ -396,6 +422,11 @@ impl Simulation {
         self.wall_stride = stride;
         self.wall_slots.clear();
         self.wall_slots.resize(n * stride, WallContact::default());
+        if events {
+            std::mem::swap(&mut self.wall_event, &mut self.old_wall_event);
+            self.wall_event.clear();
+            self.wall_event.resize(n * stride, EventAcc::default());
+        }
         for i in 0..n {
             for (k, &(wall, triangle)) in found[start[i]..start[i + 1]].iter().enumerate() {
                 let carried = self
@@ -403,14 +434,34 @@ impl Simulation {
                     .get(i * old_stride..(i + 1) * old_stride)
                     .and_then(|s| {
                         s.iter()
-                            .find(|s| s.wall == wall && s.triangle == triangle)
-                            .copied()
+                            .position(|s| s.wall == wall && s.triangle == triangle)
                     });
-                self.wall_slots[i * stride + k] = carried.unwrap_or(WallContact {
-                    wall,
-                    triangle,
-                    ..Default::default()
-                });
+                self.wall_slots[i * stride + k] = match carried {
+                    Some(q) => {
+                        if events {
+                            let from = i * old_stride + q;
+                            self.wall_event[i * stride + k] = self.old_wall_event[from];
+                            // carried: not logged as dropped below
+                            self.old_wall_event[from].open = false;
+                        }
+                        self.old_slots[i * old_stride + q]
+                    }
+                    None => WallContact {
+                        wall,
+                        triangle,
+                        ..Default::default()
+                    },
+                };
+            }
+        }
+        if events {
+            // open contacts of slots the new lists drop (a removed particle, a wall out of
+            // reach)
+            for k in 0..self.old_wall_event.len() {
+                let (acc, wall) = (self.old_wall_event[k], self.old_slots[k].wall);
+                if wall != NO_WALL && acc.open {
+                    self.close_dropped(&acc, (k / old_stride) as u32, Partner::Wall(wall));
+                }
             }
         }
         self.reference_position.clone_from(&self.position);

@@ -183,6 +183,9 @@ impl Simulation {
                 run((0, whole));
             }
         }
+        if self.record_events {
+            self.accumulate_events();
+        }
         self.sync_active_lists();
         // ---- particle phase: gather in list order, advance
         {
