@@ -264,7 +264,7 @@ def _cmd_assess(args: argparse.Namespace) -> int:
         model = StressModel.load(args.stress_model)
     result = assess(args.scene, out=args.out, duration=args.duration, quick=args.quick,
                     full=args.full, throughput=args.throughput, fresh=args.fresh,
-                    threads=args.threads, stress_model=model,
+                    threads=args.threads, stress_model=model, refeed=not args.no_refeed,
                     progress=True, log=lambda line: print(line, flush=True))
     s = result["summary"]
     print(f"P per passage: mean {s['p_passage_mean']:.3g}, max {s['p_passage_max']:.3g}; "
@@ -394,13 +394,18 @@ def build_parser() -> argparse.ArgumentParser:
     a.add_argument("scene", nargs="?", default=None, metavar="SCENE.toml",
                    help="table scene file (default: the built-in default table)")
     a.add_argument("--duration", type=float, default=None,
-                   help="simulated time of the table, s (1.0; --quick: 0.1; --full: 10)")
+                   help="a fixed simulated time of the table, s, statistics over its second "
+                        "half (default: until the collision rate is steady, at most 12 s; "
+                        "--full: 30 s; --quick: 0.1 s)")
     a.add_argument("--out", default="demfem_out/assess", help="output directory "
                    "(demfem_out/assess); the same settings there resume from the last "
                    "completed stage, other settings are refused")
     a.add_argument("--quick", action="store_true", help="a smoke run (0.1 s simulated)")
-    a.add_argument("--full", action="store_true", help="the full-accuracy run: 10 s of table "
-                   "(statistics over the last 5 s) instead of 1 s")
+    a.add_argument("--full", action="store_true", help="the full-accuracy run: until four gate "
+                   "periods agree within 10 %% (default: two within 15 %%)")
+    a.add_argument("--no-refeed", action="store_true", help="run the scene as a batch that "
+                   "drains (default: cartridges leaving are re-fed upstream, so the table "
+                   "reaches a steady state)")
     a.add_argument("--throughput", type=float, default=6000.0, metavar="PER_HOUR",
                    help="cartridges per hour through the table (6000, a planning assumption)")
     a.add_argument("--threads", type=int, default=min(2, os.cpu_count() or 1),

@@ -181,11 +181,24 @@ def _measured_events(run, v_min: float, f_min: float) -> tuple[np.ndarray, dict[
     ev["peak_force"], ev["duration"] = sel["peak_normal_force"], sel["duration"]
     ev["impulse"], ev["measured"] = sel["normal_impulse"], True
     ev = ev[np.argsort(ev["time"], kind="stable")]
-    dropped = c["normal_speed"][impact & ~hard]
     per_wall = {n: int(np.sum(w & (sel["j"] == k))) for k, n in enumerate(names)
                 if n not in NOT_IMPACTS}
-    n_belt = int(np.sum(wall & ~impact))
-    return ev, _summary(len(c), ev, int(w.sum()), per_wall, n_belt, dropped, v_min, names,
+    # the run may have stored only the events it was asked to keep: count the dropped from
+    # its onsets (every contact has one)
+    o, wo = run.onsets, run.wall_onsets
+    if o is not None and wo is not None and len(o) + len(wo) >= len(c):
+        wo_impact = impact_by_wall[np.asarray(wo["wall"], np.int64)] if n_walls else \
+            np.ones(len(wo), bool)
+        speeds = np.concatenate([np.asarray(o["normal_speed"], float),
+                                 np.asarray(wo["normal_speed"], float)[wo_impact]])
+        n_impact_onsets = len(speeds)
+        slow = speeds[speeds < v_min]
+        dropped = np.sort(slow)[:max(n_impact_onsets - len(ev), 0)]
+        n_all, n_belt = len(o) + len(wo), int(np.sum(~wo_impact))
+    else:
+        dropped = c["normal_speed"][impact & ~hard]
+        n_all, n_belt = len(c), int(np.sum(wall & ~impact))
+    return ev, _summary(n_all, ev, int(w.sum()), per_wall, n_belt, dropped, v_min, names,
                         measured=True)
 
 

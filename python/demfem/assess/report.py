@@ -90,7 +90,14 @@ def render_report(risk: dict[str, Any], figures: dict[str, bytes],
                  f"z = {_n(st['poisson_z'])}: "
                  + ("no drift detectable" if st["steady"] else "the rate drifts: the window is "
                     "not yet steady, lengthen the run") + "); hazard ratio second/first half "
-                 f"{_n(st['hazard_ratio'])}.</p>")
+                 f"{_n(st['hazard_ratio'])}."
+                 + (f" Per gate period of {_n(st['period_s'])} s: events "
+                    f"{', '.join(str(c) for c in st['period_events'])} (largest deviation from "
+                    f"their mean {100 * st['deviation']:.1f} %, tolerance "
+                    f"{100 * st['tolerance']:.0f} %: "
+                    + ("steady" if st["steady"] else "not steady")
+                    + f"); hazard deviation {100 * st['hazard_deviation']:.1f} %."
+                    if st.get("criterion") == "periods" else "") + "</p>")
     parts.append("<h2>Figures</h2>")
     for name, png in figures.items():
         b64 = base64.b64encode(png).decode("ascii")

@@ -89,7 +89,10 @@ def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[st
     p = event_probabilities(stress, INNER_SURFACE, OUTER_SURFACE, scg)
     n = run.n_particles
     cr = cartridge_risk(events, p["p_event"], n, run.removal_times, window, throughput)
-    steady = steady_state(events, p["p_event"], window)
+    rule = settings.get("until_steady") or {}
+    period = rule.get("period") or (float(table.gate_period) if table.gate_amplitude > 0
+                                    else None)
+    steady = steady_state(events, p["p_event"], window, period, rule.get("tolerance", 0.15))
     wall_names = [str(x) for x in run.info.get("wall_names", [])]
     worst = worst_events(events, p, stress, window, wall_names=wall_names)
     pos = run.positions[np.isfinite(run.positions[..., 0])]
@@ -140,9 +143,16 @@ def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[st
                         "impact speeds come from a softer table; the forces are evaluated at "
                         f"E = {e_stress:.3g} Pa.")
     if not steady["steady"]:
-        warnings.append("The collision rate drifts across the statistics window (Poisson "
-                        f"z = {steady['poisson_z']:.2f}): the window is not a steady state; "
-                        "run longer or discard more.")
+        warnings.append(
+            "The collision rate drifts across the statistics window ("
+            + (f"the events of its {len(steady['period_events'])} gate periods deviate up to "
+               f"{steady['deviation']:.0%} from their mean, tolerance "
+               f"{steady['tolerance']:.0%}" if steady["criterion"] == "periods" else
+               f"Poisson z = {steady['poisson_z']:.2f}")
+            + "): the window is not a steady state; run longer (--full, --duration).")
+    if not table.refeed:
+        warnings.append("The table is not re-fed: it drains as cartridges leave, so its "
+                        "collision rate has no steady state (assess re-feeds by default).")
     if w < 0.5:
         warnings.append(f"Short statistics window ({w:.3g} s, less than a quarter of the "
                         "gate period of the default table): a smoke run, not an assessment.")

@@ -156,11 +156,17 @@ def event_hazard(events: np.ndarray, p: np.ndarray) -> np.ndarray:
     return -np.log1p(-np.asarray(p, float)) * np.where(events["j"] >= 0, 2.0, 1.0)
 
 
-def steady_state(events: np.ndarray, p_event: np.ndarray,
-                 window: tuple[float, float]) -> dict[str, Any]:
+def steady_state(events: np.ndarray, p_event: np.ndarray, window: tuple[float, float],
+                 period: Optional[float] = None, tolerance: float = 0.15) -> dict[str, Any]:
     """How steady the window is: events and hazard (Σ −ln(1 − P_k), both partners) per second
     in its first and second half, their ratio, and the Poisson z = (n_2 − n_1)/√(n_1 + n_2)
-    of the event counts (|z| < 2: no drift detectable at the 95 % level)."""
+    of the event counts; and, when the window holds at least two whole ``period`` s (the
+    gate's), the events and hazard of each period (``period_events``, ``period_hazard``) and
+    their largest relative deviation from the mean (``deviation``, ``hazard_deviation``).
+
+    ``steady``: with periods, every period's events within ``tolerance`` of their mean (the
+    rate swings within a gate period, so only whole periods compare); without, |z| < 2 (no
+    drift detectable at the 95 % level)."""
     t0, t1 = window
     mid = 0.5 * (t0 + t1)
     half = 0.5 * (t1 - t0)
@@ -171,13 +177,30 @@ def steady_state(events: np.ndarray, p_event: np.ndarray,
     n1, n2 = int(a.sum()), int(b.sum())
     z = (n2 - n1) / math.sqrt(n1 + n2) if n1 + n2 > 0 else 0.0
     h1, h2 = float(h[a].sum()), float(h[b].sum())
-    return {"window_s": [t0, t1], "events_first_half": n1, "events_second_half": n2,
-            "rate_first_half_per_s": n1 / half if half > 0 else math.nan,
-            "rate_second_half_per_s": n2 / half if half > 0 else math.nan,
-            "rate_ratio": n2 / n1 if n1 > 0 else math.nan, "poisson_z": z,
-            "steady": bool(abs(z) < 2.0),
-            "hazard_first_half": h1, "hazard_second_half": h2,
-            "hazard_ratio": h2 / h1 if h1 > 0 else math.nan}
+    out: dict[str, Any] = {
+        "window_s": [t0, t1], "events_first_half": n1, "events_second_half": n2,
+        "rate_first_half_per_s": n1 / half if half > 0 else math.nan,
+        "rate_second_half_per_s": n2 / half if half > 0 else math.nan,
+        "rate_ratio": n2 / n1 if n1 > 0 else math.nan, "poisson_z": z,
+        "steady": bool(abs(z) < 2.0), "criterion": "poisson_z",
+        "hazard_first_half": h1, "hazard_second_half": h2,
+        "hazard_ratio": h2 / h1 if h1 > 0 else math.nan}
+    n_periods = int(math.floor((t1 - t0) / period + 1e-9)) if period else 0
+    if period and n_periods >= 2:
+        edges = t1 - period * np.arange(n_periods, -1, -1)
+        counts = np.histogram(t, edges)[0].astype(float)
+        hz = np.histogram(t, edges, weights=h)[0]
+
+        def deviation(x: np.ndarray) -> float:
+            m = float(np.mean(x))
+            return float(np.max(np.abs(x / m - 1.0))) if m > 0 else math.inf
+
+        out.update({"period_s": float(period), "period_events": [int(c) for c in counts],
+                    "period_hazard": [float(x) for x in hz],
+                    "deviation": deviation(counts), "hazard_deviation": deviation(hz),
+                    "tolerance": float(tolerance), "criterion": "periods",
+                    "steady": bool(deviation(counts) <= tolerance)})
+    return out
 
 
 def worst_events(events: np.ndarray, p: dict[str, np.ndarray], stress: dict[str, np.ndarray],

@@ -29,14 +29,31 @@ from demfem.assess.stages import STAGES, StageBook
 from demfem.assess.stress_model import StressModel
 from demfem.errors import InvalidParameterError, check_positive, check_range
 
-__all__ = ["assess", "OUTPUT_FILES", "QUICK_DURATION", "DEFAULT_DURATION", "FULL_DURATION"]
+__all__ = ["assess", "OUTPUT_FILES", "QUICK_DURATION", "DEFAULT_DURATION", "FULL_DURATION",
+           "steady_rule"]
 
-#: Default and --quick simulated time of the table, s.
-DEFAULT_DURATION = 1.0
+#: Longest simulated time of the default run, s: it runs until the collision rate is steady
+#: (:func:`steady_rule`: two gate periods within 15 %), at most this long.
+DEFAULT_DURATION = 12.0
+#: ``quick``: a fixed 0.1 s smoke run, statistics over its second half.
 QUICK_DURATION = 0.1
-#: ``full``: the table for 10 s, statistics over its second half (docs/assess.md gives the
-#: measured difference from the default).
-FULL_DURATION = 10.0
+#: ``full``: until four gate periods agree within 10 %, at most this long, s (docs/assess.md
+#: gives the measured difference from the default).
+FULL_DURATION = 30.0
+
+
+def steady_rule(table, full: bool = False, min_speed: float = DEFAULT_MIN_SPEED):
+    """The :class:`demfem.studies.steady.SteadyRule` of an assessment of ``table``: periods
+    of the gate (1 s for a still gate), after a 2 s warm-up, two periods within 15 % (``full``:
+    four within 10 %), impacts as the events stage counts them (not the belt)."""
+    from demfem.assess.events import NOT_IMPACTS
+    from demfem.studies.steady import SteadyRule
+
+    names = [str(w["name"]) for w in table.build().walls]
+    return SteadyRule(period=float(table.gate_period) if table.gate_amplitude > 0 else 1.0,
+                      window_periods=4 if full else 2, warmup=2.0,
+                      tolerance=0.10 if full else 0.15, min_speed=min_speed,
+                      excluded_walls=tuple(k for k, n in enumerate(names) if n in NOT_IMPACTS))
 
 #: Files the job writes (removed by a fresh start), besides the DEM checkpoint.
 OUTPUT_FILES = ("calibration.json", "table_run.npz", "events.npz", "stress.npz", "risk.json",
@@ -67,6 +84,18 @@ def _flatten(d: dict[str, Any], prefix: str = "") -> dict[str, Any]:
     return out
 
 
+def _event_min_force(table, e_stress: float, v_min: float) -> float:
+    """Peak force (N) of a cartridge–cartridge impact at ``v_min`` (m/s): a contact that began
+    slower is an event if the DEM measured at least this force on it (pressed by the
+    queue)."""
+    from demfem.assess.impact import ImpactLaw, cartridge_body
+
+    if v_min <= 0:
+        return 0.0
+    body = cartridge_body(e_stress, table.poisson_ratio)
+    return float(ImpactLaw(body, body).force(np.array([v_min]))[0])
+
+
 def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
            duration: Optional[float] = None, quick: bool = False, full: bool = False,
            throughput: float = DEFAULT_THROUGHPUT, fresh: bool = False,
@@ -75,16 +104,19 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
            stress_young_modulus: Optional[float] = None, slow_crack_growth: bool = True,
            threads: int = 1, checkpoint_every: float = 15.0,
            log: Callable[[str], None] = print, progress: bool = False,
-           stop_after: Optional[str] = None) -> dict[str, Any]:
+           stop_after: Optional[str] = None, refeed: bool = True) -> dict[str, Any]:
     """Run (or resume) the assessment; returns the risk document (``risk.json``'s content).
 
     Args:
         scene: the table: None (built-in default), an AccumulationTable or a TOML file.
         out: output folder.
-        duration: simulated time of the table, s (default 1.0; ``quick``: 0.1).
+        duration: simulated time of the table, s, fixed (statistics over its second half, or
+            from ``discard_before``). Default: run until the collision rate is steady
+            (:func:`steady_rule`), at most 12 s (``full``: 30 s), statistics over the
+            steady periods.
         quick: a smoke run (0.1 s simulated).
-        full: the full-accuracy run: 10 s of table, so the statistics window (its second
-            half) holds ten times the collisions of the default.
+        full: the full-accuracy run: until four gate periods agree within 10 % (the default:
+            two within 15 %).
         throughput: cartridges per hour through the table, > 0 (a planning assumption).
         fresh: replace an assessment with other settings in ``out`` instead of refusing it.
         sample_interval: time between recorded samples, s (default 0.02; quick 0.01).
@@ -99,6 +131,9 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
         log: where progress lines go.
         progress: a progress bar on standard error for the DEM stage.
         stop_after: stop after this stage (one of STAGES): a later call resumes from there.
+        refeed: re-insert upstream the cartridges that leave through the opening, so the table
+            stays in operation (a batch that drains has no steady state); False runs the
+            scene as it is.
     """
     from demfem.pipeline import load_scene
     from demfem.risk import INNER_SURFACE, OUTER_SURFACE, SCG_BOROSILICATE
@@ -107,6 +142,7 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
     # every argument checked before any work
     if quick and full:
         raise InvalidParameterError("invalid quick = full = True: choose one of quick and full")
+    until_steady = duration is None and not quick
     if duration is None:
         duration = QUICK_DURATION if quick else FULL_DURATION if full else DEFAULT_DURATION
     if sample_interval is None:
@@ -116,13 +152,22 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
     duration = float(duration)
     q = check_positive("throughput", throughput)
     v_min = check_range("min_speed", min_speed, 0.0, math.inf, lo_open=False)
+    if until_steady and discard_before is not None:
+        raise InvalidParameterError(
+            f"invalid discard_before = {discard_before!r}: the run until steady takes its "
+            "statistics over its steady periods; give a fixed duration to choose the window")
     t0 = 0.5 * duration if discard_before is None else check_range(
         "discard_before", discard_before, 0.0, duration, lo_open=False)
+    if not isinstance(refeed, bool):
+        raise InvalidParameterError(f"invalid refeed = {refeed!r}: must be True or False")
     check_positive("checkpoint_every", checkpoint_every)
     if stop_after is not None and stop_after not in STAGES:
         raise InvalidParameterError(f"invalid stop_after = {stop_after!r}: must be one of "
                                     f"{STAGES}")
     table = load_scene(scene)
+    if refeed and not table.refeed:
+        table = dataclasses.replace(table, refeed=True)
+    rule = steady_rule(table, full, v_min) if until_steady else None
     model = stress_model if stress_model is not None else StressModel.default()
     if not isinstance(model, StressModel):
         raise InvalidParameterError(f"invalid stress_model = {model!r}: must be a StressModel")
@@ -131,7 +176,8 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
     scg = SCG_BOROSILICATE if slow_crack_growth else None
     settings = {"scene": dataclasses.asdict(table), "duration_s": duration,
                 "sample_interval_s": float(sample_interval), "min_speed_m_per_s": v_min,
-                "statistics_from_s": t0, "throughput_per_hour": q,
+                "statistics_from_s": None if rule else t0,
+                "until_steady": rule.to_dict() if rule else None, "throughput_per_hour": q,
                 "stress_young_modulus_Pa": e_stress, "stress_model": model.to_dict(),
                 "slow_crack_growth": dataclasses.asdict(scg) if scg else None,
                 "inner_surface": dataclasses.asdict(INNER_SURFACE),
@@ -188,7 +234,8 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
     run_path = out / "table_run.npz"
     done = book.is_done("dem")
     header(2, f"the table, {table.n_spheres} spheres, E = {table.young_modulus:.3g} Pa, "
-              f"{duration:g} s", done)
+              + (f"until the collision rate is steady (at most {duration:g} s)" if rule
+                 else f"{duration:g} s") + (", re-fed" if table.refeed else ""), done)
     if not done:
         from demfem.progress import ProgressBar
 
@@ -197,7 +244,8 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
             run = run_table(table, duration, sample_interval, threads=threads,
                             progress=bar, checkpoint=out / "table.ck",
                             checkpoint_every=checkpoint_every, fresh=fresh,
-                            record_events=True)
+                            record_events=True, steady=rule,
+                            keep_events=(v_min, _event_min_force(table, e_stress, v_min)))
         finally:
             if bar is not None:
                 bar.close()
@@ -207,6 +255,15 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
         run = TableRun.load(run_path)
     log(f"  {run.info['steps']} steps of {run.info['dt']:.3g} s, "
         f"{len(run.onsets)} contact onsets, wall {run.info['wall_time_s']:.1f} s")
+    end = float(run.info["duration"])
+    if rule is not None:
+        # the statistics window: the periods the rule compared (the last ones if the run
+        # reached its longest duration unsteady)
+        t0 = max(end - rule.window, 0.0)
+        check = run.info.get("steady") or {}
+        log(f"  {'steady' if check.get('steady') else 'NOT steady'} at t = {end:g} s: impacts "
+            f"per {rule.period:g} s period {check.get('counts')} (largest deviation "
+            f"{check.get('deviation', float('nan')):.1%}, tolerance {rule.tolerance:.0%})")
     if stop_after == "dem":
         return {"stopped_after": "dem"}
 
@@ -217,12 +274,7 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
     done = book.is_done("events")
     header(3, f"impact events (normal speed >= {v_min:g} m/s)", done)
     if not done:
-        # a contact that began below the minimum speed is kept if the DEM measured a peak
-        # force at least that of an impact at the minimum speed
-        f_min = float(ImpactLaw(cartridge_body(e_stress, table.poisson_ratio),
-                                cartridge_body(e_stress, table.poisson_ratio)).force(
-            np.array([v_min]))[0]) if v_min > 0 else 0.0
-        events, ev_summary = impact_events(run, v_min, f_min)
+        events, ev_summary = impact_events(run, v_min, _event_min_force(table, e_stress, v_min))
         _save_npz(ev_path, events=events, summary=np.array(json.dumps(ev_summary)))
         book.complete("events", [ev_path])
     data = _load_npz(ev_path)
@@ -268,7 +320,7 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
     header(5, "Weibull probabilities per event, cartridge and hour", done)
     if not done:
         files = risk_document(out, run, table, events, ev_summary, stress, model, scg,
-                              (t0, duration), q, settings, e_stress)
+                              (t0, end), q, settings, e_stress)
         book.complete("risk", files)
     risk = json.loads((out / "risk.json").read_text(encoding="utf-8"))
     s = risk["summary"]
@@ -289,9 +341,9 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
         figs = make_figures(out, {
             "map": {k: arrays[f"map_{k}"] for k in ("hazard", "count", "x_edges", "y_edges")},
             "onset_speeds": run.onsets["normal_speed"], "events": events,
-            "window": (t0, duration), "min_speed": v_min, "stress": stress, "model": model,
+            "window": (t0, end), "min_speed": v_min, "stress": stress, "model": model,
             "p_passage": arrays["p_passage"], "steady": risk["steady_state"],
-            "duration": duration})
+            "duration": end})
         html_path = write_text_atomic(out / "report.html",
                                       render_report(risk, figs, figures_names))
         book.complete("report", [html_path, *(out / n for n in figs)])

@@ -14,7 +14,6 @@ SI units: m, s, m/s, N, Pa.
 """
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass
 from pathlib import Path

@@ -26,8 +26,8 @@ from typing import Any, Callable, Mapping, Optional
 
 import numpy as np
 
-from demfem.analysis.collisions import ONSET_DTYPE, WALL_ONSET_DTYPE
-from demfem.analysis.contact_events import CONTACT_EVENT_DTYPE, contact_event_table
+from demfem.analysis.collisions import WALL_ONSET_DTYPE
+from demfem.analysis.contact_events import CONTACT_EVENT_DTYPE
 from demfem.analysis.forces import first_line_force, force_statistics
 from demfem.analysis.coordination import mean_coordination
 from demfem.errors import (CheckpointError, DemfemIOError, InvalidParameterError,
@@ -36,6 +36,8 @@ from demfem.io.atomic import atomic_path
 from demfem.io.strict_json import dumps as json_dumps
 from demfem.progress import ProgressBar
 from demfem.scenes.table import AccumulationTable
+from demfem.studies.steady import SteadyRule
+from demfem.studies.table_record import ARRAYS, Recorder, event_columns, kept_events
 
 __all__ = ["TableRun", "run_table", "sweep_point", "table_from_params", "RUN_OPTIONS",
            "check_run_arguments", "checkpoint_files", "checkpoint_state", "run_settings",
@@ -45,8 +47,6 @@ __all__ = ["TableRun", "run_table", "sweep_point", "table_from_params", "RUN_OPT
 RUN_OPTIONS = ("duration", "sample_interval", "model", "run_dir", "checkpoint_every",
                "discard_before", "quantile", "narrowest_opening")
 
-_ARRAYS = ("times", "positions", "velocities", "coordination", "forces", "opening",
-           "riding_up", "max_overlap", "kinetic_energy")
 
 
 @dataclass
@@ -150,7 +150,7 @@ class TableRun:
 
     def save(self, path: str | Path) -> Path:
         """Write the run to ``path`` (``.npz``) atomically; returns the path."""
-        arrays = {name: getattr(self, name) for name in _ARRAYS}
+        arrays = {name: getattr(self, name) for name in ARRAYS}
         arrays.update(tags=self.tags, radii=self.radii, removal_times=self.removal_times,
                       onsets=self.onsets, wall_onsets=self.wall_onsets,
                       contact_events=self.contact_events)
@@ -173,7 +173,7 @@ class TableRun:
             raise DemfemIOError(f"i/o error on {path}: {exc}") from None
         except (KeyError, ValueError) as exc:
             raise InvalidParameterError(f"invalid table run file {path}: {exc}") from None
-        missing = [k for k in (*_ARRAYS, "tags", "radii", "removal_times", "onsets")
+        missing = [k for k in (*ARRAYS, "tags", "radii", "removal_times", "onsets")
                    if k not in arrays]
         if missing:
             raise InvalidParameterError(f"invalid table run file {path}: missing "
@@ -214,183 +214,6 @@ class TableRun:
         }
 
 
-
-
-# --------------------------------------------------------------------------------------------
-# Recording
-# --------------------------------------------------------------------------------------------
-
-class _Recorder:
-    """Accumulates samples and onsets; can be saved to / restored from a partial record."""
-
-    def __init__(self, n: int) -> None:
-        self.n = n
-        self.frames: dict[str, list[np.ndarray]] = {k: [] for k in _ARRAYS}
-        self.onset_parts: list[dict[str, np.ndarray]] = []
-        self.wall_parts: list[dict[str, np.ndarray]] = []
-        self.event_parts: list[dict[str, np.ndarray]] = []
-        self.removal_times = np.full(n, np.nan)
-
-    def sample(self, sim, table: AccumulationTable) -> None:
-        alive = np.asarray(sim.alive(), bool)
-        gone = ~alive
-        pos = np.array(sim.positions(), float)
-        vel = np.array(sim.velocities(), float)
-        force = np.array(sim.contact_force_sums(), float)
-        z = np.asarray(sim.coordination(), float)
-        for a in (pos, vel, force):
-            a[gone] = np.nan
-        z = np.where(alive, z, np.nan)
-        t = float(sim.time)
-        f = self.frames
-        f["times"].append(np.array(t))
-        f["positions"].append(pos)
-        f["velocities"].append(vel)
-        f["coordination"].append(z)
-        f["forces"].append(force)
-        f["opening"].append(np.array(float(table.opening_width_at(t))))
-        f["riding_up"].append(np.array(int(sim.riding_up_count())))
-        f["max_overlap"].append(np.array(float(sim.max_overlap())))
-        f["kinetic_energy"].append(np.array(float(sim.kinetic_energy())))
-
-    def collect_events(self, sim, contact_events: bool = False) -> None:
-        """Move the engine's onset log, removals and (``contact_events``) whole-contact
-        events into the record (and clear the logs)."""
-        if contact_events:
-            self.event_parts.append(_event_columns(sim.events()))
-        o = sim.onsets()
-        wall = np.asarray(o["partner_is_wall"], bool)
-        for keep, parts in ((~wall, self.onset_parts), (wall, self.wall_parts)):
-            parts.append({
-                "i": np.asarray(o["particle"], np.int64)[keep],
-                "j": np.asarray(o["partner"], np.int64)[keep],
-                "time": np.asarray(o["time"], float)[keep],
-                "normal_speed": np.asarray(o["normal_speed"], float)[keep],
-                "tangential_speed": np.asarray(o["tangential_speed"], float)[keep],
-            })
-        point = np.asarray(o["partner_position"], float).reshape(-1, 3)[wall]
-        self.wall_parts[-1]["point"] = point
-        sim.clear_records()
-        times, index = sim.removals()
-        index = np.asarray(index, np.int64)
-        new = np.isnan(self.removal_times[index])
-        self.removal_times[index[new]] = np.asarray(times, float)[new]
-
-    def stacked(self) -> dict[str, np.ndarray]:
-        return {k: np.stack(v) if v else np.zeros(0) for k, v in self.frames.items()}
-
-    def raw_onsets(self, walls: bool = False) -> dict[str, np.ndarray]:
-        names: tuple[str, ...] = ("i", "j", "time", "normal_speed", "tangential_speed")
-        parts = self.wall_parts if walls else self.onset_parts
-        if walls:
-            names += ("point",)
-        if not parts:
-            empty = {k: np.zeros(0, np.int64 if k in "ij" else float) for k in names}
-            if walls:
-                empty["point"] = np.zeros((0, 3))
-            return empty
-        return {k: np.concatenate([p[k] for p in parts]) for k in names}
-
-    def wall_onset_table(self, times: np.ndarray, coordination: np.ndarray) -> np.ndarray:
-        raw = self.raw_onsets(walls=True)
-        table = np.zeros(len(raw["time"]), WALL_ONSET_DTYPE)
-        table["i"], table["wall"], table["time"] = raw["i"], raw["j"], raw["time"]
-        table["normal_speed"] = raw["normal_speed"]
-        table["tangential_speed"] = raw["tangential_speed"]
-        table["impact_angle"] = np.arctan2(raw["tangential_speed"], raw["normal_speed"])
-        table["x"], table["y"], table["z"] = raw["point"].T if len(table) else ([], [], [])
-        if len(table):
-            frame = _nearest_frame(times, raw["time"])
-            table["coordination_i"] = _coordination_at(coordination, frame, raw["i"])
-        return table[np.argsort(table["time"], kind="stable")]
-
-    def onset_table(self, times: np.ndarray, coordination: np.ndarray) -> np.ndarray:
-        raw = self.raw_onsets()
-        table = np.zeros(len(raw["time"]), ONSET_DTYPE)
-        for k in ("i", "j", "time", "normal_speed", "tangential_speed"):
-            table[k] = raw[k]
-        table["impact_angle"] = np.arctan2(raw["tangential_speed"], raw["normal_speed"])
-        if len(table):
-            frame = _nearest_frame(times, raw["time"])
-            table["coordination_i"] = _coordination_at(coordination, frame, raw["i"])
-            table["coordination_j"] = _coordination_at(coordination, frame, raw["j"])
-        return table[np.argsort(table["time"], kind="stable")]
-
-    def raw_events(self, open_now: Optional[dict[str, np.ndarray]] = None
-                   ) -> dict[str, np.ndarray]:
-        """The recorded event columns, and those of ``open_now`` (the contacts open at the
-        end), concatenated."""
-        parts = self.event_parts + ([open_now] if open_now is not None else [])
-        if not parts:
-            return _event_columns(None)
-        return {k: np.concatenate([p[k] for p in parts]) for k in _EVENT_COLUMNS}
-
-    def event_table(self, times: np.ndarray, coordination: np.ndarray, radii: np.ndarray,
-                    open_now: dict[str, np.ndarray]) -> np.ndarray:
-        table = contact_event_table(self.raw_events(open_now), radii)
-        if len(table):
-            frame = _nearest_frame(times, table["time"])
-            table["coordination_i"] = _coordination_at(coordination, frame, table["i"])
-            sphere = ~table["partner_is_wall"]
-            table["coordination_j"][sphere] = _coordination_at(coordination, frame[sphere],
-                                                               table["j"][sphere])
-        return table
-
-    def save_partial(self, path: Path) -> None:
-        arrays: dict[str, Any] = {f"frame_{k}": v for k, v in self.stacked().items()}
-        arrays.update({f"event_{k}": v for k, v in self.raw_events().items()})
-        arrays.update({f"onset_{k}": v for k, v in self.raw_onsets().items()})
-        arrays.update({f"wall_onset_{k}": v for k, v in self.raw_onsets(walls=True).items()})
-        arrays["removal_times"] = self.removal_times
-        with atomic_path(path, suffix=".npz") as tmp:
-            with open(tmp, "wb") as fh:
-                np.savez(fh, **arrays)
-
-    def load_partial(self, path: Path) -> None:
-        with np.load(path, allow_pickle=False) as data:
-            for k in _ARRAYS:
-                self.frames[k] = list(data[f"frame_{k}"])
-            self.onset_parts = [{k: data[f"onset_{k}"] for k in
-                                 ("i", "j", "time", "normal_speed", "tangential_speed")}]
-            if "wall_onset_time" in data.files:
-                self.wall_parts = [{k: data[f"wall_onset_{k}"] for k in
-                                    ("i", "j", "time", "normal_speed", "tangential_speed",
-                                     "point")}]
-            if "event_time" in data.files:
-                self.event_parts = [{k: data[f"event_{k}"] for k in _EVENT_COLUMNS}]
-            self.removal_times = np.array(data["removal_times"], float)
-
-
-#: The engine's event columns (:meth:`demfem._core.DemSimulation.events`).
-_EVENT_COLUMNS = ("time", "duration", "particle", "partner", "partner_is_wall", "normal_speed",
-                  "tangential_speed", "position", "partner_position", "peak_normal_force",
-                  "normal_impulse", "peak_tangential_force", "max_overlap", "complete")
-
-
-def _event_columns(raw: Optional[Mapping[str, Any]]) -> dict[str, np.ndarray]:
-    """The engine's event dict as plain arrays (an empty table for ``None``)."""
-    kinds = {"particle": np.int64, "partner": np.int64, "partner_is_wall": bool,
-             "complete": bool}
-    out = {}
-    for k in _EVENT_COLUMNS:
-        value = np.zeros(0) if raw is None else raw[k]
-        a = np.asarray(value, kinds.get(k, float))
-        out[k] = a.reshape(-1, 3) if k in ("position", "partner_position") else a
-    return out
-
-
-def _coordination_at(coordination: np.ndarray, frame: np.ndarray,
-                     sphere: np.ndarray) -> np.ndarray:
-    """Coordination of each ``sphere`` at its ``frame`` as int64; −1 where it had left."""
-    z = coordination[frame, sphere]
-    return np.where(np.isfinite(z), z, -1).astype(np.int64)
-
-
-def _nearest_frame(frame_times: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """Index of the sample nearest each time in ``t``."""
-    k = np.clip(np.searchsorted(frame_times, t), 1, len(frame_times) - 1)
-    left_nearer = (t - frame_times[k - 1]) <= (frame_times[k] - t)
-    return np.where(left_nearer, k - 1, k)
 
 
 def check_run_arguments(duration: float, sample_interval: float, threads: int) -> None:
@@ -457,7 +280,9 @@ def run_table(table: AccumulationTable, duration: float, sample_interval: float 
               progress: Optional[Callable[[float, int], None]] = None,
               checkpoint: Optional[str | Path] = None, checkpoint_every: float = 300.0,
               dt: Optional[float] = None, fresh: bool = False,
-              overlap_fraction: float = 0.1, record_events: bool = False) -> TableRun:
+              overlap_fraction: float = 0.1, record_events: bool = False,
+              steady: Optional[SteadyRule] = None,
+              keep_events: Optional[tuple[float, float]] = None) -> TableRun:
     """Run ``table`` for ``duration`` s of simulated time and sample it every
     ``sample_interval`` s (samples at 0, Δ, 2Δ, ... up to ``duration``).
 
@@ -486,6 +311,13 @@ def run_table(table: AccumulationTable, duration: float, sample_interval: float 
             forces and impulse (:attr:`TableRun.contact_events`); the engine then writes
             every contact's normal force on every step (about 1.3x the step's time on the
             default table, ``benches/dem_events_cost.py``).
+        steady: stop before ``duration`` (then the longest run) once the collision rate is
+            steady by this :class:`demfem.studies.steady.SteadyRule`, checked at every whole
+            period; ``info["steady"]`` holds the last check and ``info["duration"]`` the time
+            the run ended.
+        keep_events: (min_speed m/s, min_force N): keep only the contact events that began
+            at least that fast or reached at least that force (the pack's resting chatter,
+            half of all contacts, is then not stored); None keeps every one.
 
     Returns:
         The :class:`TableRun`.
@@ -504,9 +336,15 @@ def run_table(table: AccumulationTable, duration: float, sample_interval: float 
                      record_events=record_events)
     n_samples = int(math.floor(duration / sample_interval + 1e-9))
     sample_times = sample_interval * np.arange(n_samples + 1)
-    rec = _Recorder(len(scene.radii))
+    rec = Recorder(len(scene.radii))
     wall_before = 0.0
     settings = run_settings(table, duration, sample_interval, model, dt, record_events)
+    if steady is not None:
+        settings["steady"] = steady.to_dict()
+    if record_events and keep_events is not None:
+        keep_events = (float(keep_events[0]), float(keep_events[1]))
+        settings["keep_events"] = list(keep_events)
+    last_check: Optional[dict[str, Any]] = None
     ckpt = Path(checkpoint) if checkpoint is not None else None
     files = checkpoint_files(ckpt) if ckpt is not None else None
     if ckpt is not None and fresh:
@@ -523,12 +361,16 @@ def run_table(table: AccumulationTable, duration: float, sample_interval: float 
         sim.run_until(float(sample_times[k]))
         if scene.refeed is not None:
             refeed_removed(sim, scene.refeed["sites"], scene.refeed["velocity"])
-        rec.collect_events(sim, record_events)
+        rec.collect_events(sim, record_events, keep_events)
         rec.sample(sim, table)
         check_state(sim, floor=belt, overlap_fraction=overlap_fraction)
         k += 1
         if progress is not None:
             progress(float(sim.time), int(sim.steps))
+        if steady is not None and steady.due(float(sample_times[k - 1]), float(sim.dt)):
+            last_check = steady.check(float(sample_times[k - 1]), rec.impact_times(steady))
+            if last_check["steady"]:
+                break
         now = _time.perf_counter()
         if files is not None and now - last_checkpoint >= checkpoint_every and k <= n_samples:
             _write_checkpoint(sim, rec, files, wall_before + now - start, settings)
@@ -543,12 +385,16 @@ def run_table(table: AccumulationTable, duration: float, sample_interval: float 
         wall_onsets=rec.wall_onset_table(frames["times"], frames["coordination"]),
         contact_events=(rec.event_table(frames["times"], frames["coordination"],
                                         np.asarray(scene.radii, float),
-                                        _event_columns(sim.open_events()))
+                                        kept_events(event_columns(sim.open_events()),
+                                              keep_events))
                         if record_events else np.zeros(0, CONTACT_EVENT_DTYPE)),
         info={"model": model, "events_recorded": bool(record_events), "dt": float(sim.dt), "effects": list(scene.effects),
               "wall_names": [str(w["name"]) for w in scene.walls],
               "steps": int(sim.steps), "threads": int(threads),
-              "sample_interval": float(sample_interval), "duration": float(duration),
+              "sample_interval": float(sample_interval),
+              "duration": (float(sample_times[k - 1]) if last_check and last_check["steady"]
+                           else float(duration)),
+              "steady": last_check,
               "wall_time_s": wall_before + _time.perf_counter() - start},
         **frames,
     )
@@ -597,7 +443,7 @@ def checkpoint_state(ckpt: str | Path) -> Optional[dict[str, Any]]:
     return state
 
 
-def _resume(sim, rec: _Recorder, ckpt: Path, settings: Mapping[str, Any]) -> float:
+def _resume(sim, rec: Recorder, ckpt: Path, settings: Mapping[str, Any]) -> float:
     """Restore ``sim`` and ``rec`` from the checkpoint ``ckpt``; returns the wall time used
     so far. Refuses other settings and damaged files."""
     engine, record, meta = checkpoint_files(ckpt)
@@ -644,7 +490,7 @@ def _resume(sim, rec: _Recorder, ckpt: Path, settings: Mapping[str, Any]) -> flo
     return float(state["wall_time_s"])
 
 
-def _write_checkpoint(sim, rec: _Recorder, files: tuple[Path, Path, Path],
+def _write_checkpoint(sim, rec: Recorder, files: tuple[Path, Path, Path],
                       wall_time: float, settings: Mapping[str, Any]) -> None:
     """Engine state, record so far, settings and wall time used, committed like a journal:
     the new engine state and record are written in full under temporary names, then the
