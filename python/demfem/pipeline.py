@@ -183,7 +183,7 @@ def run_pipeline(out: str | Path = "demfem_out/run", duration: float = 1.0,
     if young_modulus is not None:
         table = dataclasses.replace(table, young_modulus=check_positive("young_modulus",
                                                                          young_modulus))
-    model = "hertz_reissner_mindlin"
+    model = table.contact_model
     settings = _settings(table, duration, sample_interval, v_rel, discard, model)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)

@@ -100,3 +100,29 @@ def test_fem_calibrated_line_law_reproduces_the_stored_fem_and_runs_in_the_dem()
         dem.from_scene(scene, model="linear")
     with pytest.raises(InvalidParameterError, match="young_modulus"):
         line_contact_stiffness(-1.0, 0.2)
+
+
+def test_the_fem_line_law_is_named_in_scene_files_and_refused_by_assess(tmp_path):
+    """`contact_model = "fem_line"` in a table scene file runs the DEM on the FEM-fitted line
+    law (run_table and demfem run take it from the scene); an unknown law is refused naming
+    the allowed ones; demfem assess refuses the line law (its stress model is for point
+    loads)."""
+    from demfem.assess import assess
+    from demfem.scenes import AccumulationTable
+    from demfem.studies import run_table
+
+    small = AccumulationTable(width=0.1, length=0.1, tilted_wall_length=0.05, n_spheres=30,
+                              contact_model="fem_line")
+    path = small.to_toml(tmp_path / "line.toml")
+    assert 'contact_model = "fem_line"' in path.read_text()
+    back = AccumulationTable.from_toml(path)
+    assert back == small
+    run = run_table(back, 0.01, sample_interval=0.005)
+    assert run.info["model"] == "fem_line" and run.parameters["contact_model"] == "fem_line"
+    # an explicit model replaces the scene's and is recorded in the run's parameters
+    other = run_table(back, 0.01, sample_interval=0.005, model="hertz_mindlin")
+    assert other.parameters["contact_model"] == "hertz_mindlin"
+    with pytest.raises(InvalidParameterError, match="contact_model.*hertz_reissner_mindlin"):
+        AccumulationTable(contact_model="hertz")
+    with pytest.raises(InvalidParameterError, match="point load"):
+        assess(path, out=tmp_path / "a", duration=0.01, log=lambda _: None)

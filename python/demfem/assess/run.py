@@ -165,6 +165,12 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
         raise InvalidParameterError(f"invalid stop_after = {stop_after!r}: must be one of "
                                     f"{STAGES}")
     table = load_scene(scene)
+    if table.contact_model == "fem_line":
+        raise InvalidParameterError(
+            "invalid contact_model = 'fem_line' for demfem assess: its forces are those of "
+            "line contacts along the cartridge body, which the stress model (a point load on "
+            "the shell) does not describe; assess the table with 'hertz_reissner_mindlin' "
+            "(or 'hertz_mindlin')")
     if refeed and not table.refeed:
         table = dataclasses.replace(table, refeed=True)
     rule = steady_rule(table, full, v_min) if until_steady else None
@@ -182,7 +188,7 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
                 "slow_crack_growth": dataclasses.asdict(scg) if scg else None,
                 "inner_surface": dataclasses.asdict(INNER_SURFACE),
                 "outer_surface": dataclasses.asdict(OUTER_SURFACE),
-                "dem_model": "hertz_reissner_mindlin", "dem_events": "measured"}
+                "dem_model": table.contact_model, "dem_events": "measured"}
     out = Path(out)
     from demfem.studies.table_run import remove_checkpoint
 

@@ -100,6 +100,10 @@ __all__ = [
 #: Particle kinds of the table: equivalent spheres, bead clumps, exact cartridge shapes.
 PARTICLES = ("sphere", "clump", "cylinder")
 
+#: Contact laws of the equivalent spheres a table scene may name (``contact_model``; see
+#: :func:`demfem.dem.from_scene`).
+TABLE_CONTACT_MODELS = ("hertz_reissner_mindlin", "hertz_mindlin", "fem_line")
+
 #: Name of this scene in scene files (the optional key ``scene``).
 SCENE_NAME = "accumulation_table"
 
@@ -387,6 +391,10 @@ class AccumulationTable:
             round(n f) of them, spread evenly over the site order (deterministic, no seed).
             1 (the default) fills every site with ``particle``; with ``particle = "sphere"``
             it must stay 1.
+        contact_model: the equivalent spheres' contact law (:data:`TABLE_CONTACT_MODELS`):
+            ``"hertz_reissner_mindlin"`` (the calibrated sphere of the paper),
+            ``"hertz_mindlin"`` (no shell) or ``"fem_line"`` (the linear law fitted to the
+            FEM of two cartridges side by side, for upright cartridges' line contacts).
     """
 
     n_spheres: int = 840
@@ -414,6 +422,7 @@ class AccumulationTable:
     packing_gap: float = 0.01
     particle: str = "sphere"
     cartridge_fraction: float = 1.0
+    contact_model: str = "hertz_reissner_mindlin"
 
     # ---- validation ------------------------------------------------------------------------
 
@@ -487,6 +496,10 @@ class AccumulationTable:
         check_range("friction", self.friction, 0.0, inf, lo_open=False)
         check_range("restitution", self.restitution, 0.0, 1.0, hi_open=False)
         check_range("rolling_resistance", self.rolling_resistance, 0.0, inf, lo_open=False)
+        if self.contact_model not in TABLE_CONTACT_MODELS:
+            raise InvalidParameterError(
+                f"invalid contact_model = {self.contact_model!r}: must be one of "
+                f"{TABLE_CONTACT_MODELS}")
         if self.particle not in PARTICLES:
             raise InvalidParameterError(
                 f"invalid particle = {self.particle!r}: must be one of {PARTICLES}")

@@ -276,7 +276,7 @@ def sha256_file(path: Path) -> str:
 
 
 def run_table(table: AccumulationTable, duration: float, sample_interval: float = 0.05,
-              threads: int = 1, model: str = "hertz_reissner_mindlin",
+              threads: int = 1, model: Optional[str] = None,
               progress: Optional[Callable[[float, int], None]] = None,
               checkpoint: Optional[str | Path] = None, checkpoint_every: float = 300.0,
               dt: Optional[float] = None, fresh: bool = False,
@@ -293,7 +293,8 @@ def run_table(table: AccumulationTable, duration: float, sample_interval: float 
         threads: engine threads; results are bitwise the same on any number. On a 2-core
             machine, 2 threads run the default table 1.4x faster than 1 (a sweep gains more
             from one run per core).
-        model: contact law, see :func:`demfem.dem.from_scene`.
+        model: contact law, see :func:`demfem.dem.from_scene` (default: the table's
+            ``contact_model``; given, it replaces it, and the run's parameters record it).
         progress: callback ``progress(sim_time_s, steps)``, e.g. a
             :class:`demfem.progress.ProgressBar`.
         checkpoint: engine checkpoint file; if it exists (with its ``.record.npz`` and its
@@ -327,6 +328,9 @@ def run_table(table: AccumulationTable, duration: float, sample_interval: float 
     from demfem.dem import check_state
 
     check_run_arguments(duration, sample_interval, threads)
+    if model is not None and model != table.contact_model:
+        table = dataclasses.replace(table, contact_model=model)
+    model = table.contact_model
     if not (math.isfinite(checkpoint_every) and checkpoint_every > 0):
         raise InvalidParameterError(f"invalid checkpoint_every = {checkpoint_every!r}: must "
                                     "be a finite number of seconds > 0")
@@ -581,7 +585,7 @@ def sweep_point(params: Mapping[str, Any]) -> dict[str, Any]:
     bar = ProgressBar(duration, label=key[:48], log_interval=60.0)
     run = run_table(table, duration,
                     sample_interval=float(params.get("sample_interval", 0.05)),
-                    model=str(params.get("model", "hertz_reissner_mindlin")),
+                    model=None if params.get("model") is None else str(params["model"]),
                     checkpoint=checkpoint,
                     checkpoint_every=float(params.get("checkpoint_every", 300.0)),
                     progress=bar)
