@@ -39,9 +39,13 @@ def _basis(model, scg, ev_summary: dict[str, Any], e_stress: float, table,
             "(undamped, an upper bound).")
     lines = [
         "Impact speeds: the DEM of the table (equivalent spheres, Hertz-Reissner-Mindlin "
-        f"contacts, E = {table.young_modulus:.3g} Pa); every contact onset with normal speed "
-        f">= {ev_summary['min_speed_m_per_s']:g} m/s is an event "
-        f"({ev_summary['n_dropped']} slower onsets dropped, the fastest of them at "
+        f"contacts, E = {table.young_modulus:.3g} Pa"
+        + (", re-fed: the table in operation" if table.refeed else ", not re-fed: a batch")
+        + f"); every contact onset with normal speed >= {ev_summary['min_speed_m_per_s']:g} "
+        "m/s is an event"
+        + (" (and a slower one that the DEM pressed to at least the force of an impact at that "
+           "speed)" if ev_summary.get("measured") else "")
+        + f" ({ev_summary['n_dropped']} slower onsets dropped, the fastest of them at "
         f"{ev_summary['max_dropped_speed_m_per_s']:.3g} m/s). {ev_summary['note']}.",
         force_line,
         f"Stress model: sigma1 = beta F/t^2 with beta_inner = {model.beta_inner:.4g}, "

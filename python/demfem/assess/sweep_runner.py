@@ -7,7 +7,8 @@ per grid point.
 
 Each point is the built-in default table with the grid's fields replaced (any
 :class:`~demfem.scenes.table.AccumulationTable` field, SI units), run by
-:func:`demfem.assess.assess` for ``duration`` s (default 1.0; a grid or a fixed parameter)
+:func:`demfem.assess.assess` for ``duration`` s (a grid or a fixed parameter; default: as
+``demfem assess``, re-fed until the collision rate is steady)
 at ``throughput`` cartridges per hour (default 6000). The assessment's folder is
 ``run_dir/<key>`` when ``run_dir`` is given (kept, resumable), else a temporary folder
 that is removed. Returns the risk summary's numbers, each key naming its unit.
@@ -37,7 +38,8 @@ def risk_point(params: dict) -> dict:
     from demfem.sweep import run_key
 
     p = dict(params)
-    duration = float(p.pop("duration", 1.0))
+    raw = p.pop("duration", None)
+    duration = None if raw is None else float(raw)
     throughput = float(p.pop("throughput", 6000.0))
     run_dir = p.pop("run_dir", None)
     fields = {f.name for f in dataclasses.fields(AccumulationTable)}
