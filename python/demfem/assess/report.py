@@ -95,11 +95,13 @@ def render_report(risk: dict[str, Any], figures: dict[str, bytes],
                  + "); hazard ratio second/first half "
                  f"{_n(st['hazard_ratio'])}."
                  + (f" Per gate period of {_n(st['period_s'])} s: events "
-                    f"{', '.join(str(c) for c in st['period_events'])} (largest deviation from "
-                    f"their mean {100 * st['deviation']:.1f} %, tolerance "
+                    f"{', '.join(str(c) for c in st['period_events'])} (standard error of "
+                    f"their mean {100 * st['relative_error']:.1f} %, tolerance "
                     f"{100 * st['tolerance']:.0f} %: "
                     + ("steady" if st["steady"] else "not steady")
-                    + f"); hazard deviation {100 * st['hazard_deviation']:.1f} %."
+                    + "); the hazard per period has a standard error of its mean of "
+                    f"{100 * st['hazard_relative_error']:.0f} %: the statistical uncertainty "
+                    "of the hourly risk from the window's length."
                     if st.get("criterion") == "periods" else "") + "</p>")
     parts.append("<h2>Figures</h2>")
     for name, png in figures.items():

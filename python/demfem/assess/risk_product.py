@@ -96,7 +96,7 @@ def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[st
     rule = settings.get("until_steady") or {}
     period = rule.get("period") or (float(table.gate_period) if table.gate_amplitude > 0
                                     else None)
-    steady = steady_state(events, p["p_event"], window, period, rule.get("tolerance", 0.15))
+    steady = steady_state(events, p["p_event"], window, period, rule.get("tolerance", 0.10))
     wall_names = [str(x) for x in run.info.get("wall_names", [])]
     worst = worst_events(events, p, stress, window, wall_names=wall_names)
     pos = run.positions[np.isfinite(run.positions[..., 0])]
@@ -149,8 +149,8 @@ def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[st
     if not steady["steady"]:
         warnings.append(
             "The collision rate drifts across the statistics window ("
-            + (f"the events of its {len(steady['period_events'])} gate periods deviate up to "
-               f"{steady['deviation']:.0%} from their mean, tolerance "
+            + (f"the mean events of its {len(steady['period_events'])} gate periods have a "
+               f"relative standard error of {steady['relative_error']:.0%}, tolerance "
                f"{steady['tolerance']:.0%}" if steady["criterion"] == "periods" else
                f"Poisson z = {steady['poisson_z']:.2f}")
             + "): the window is not a steady state; run longer (--full, --duration).")

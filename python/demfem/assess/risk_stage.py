@@ -157,16 +157,20 @@ def event_hazard(events: np.ndarray, p: np.ndarray) -> np.ndarray:
 
 
 def steady_state(events: np.ndarray, p_event: np.ndarray, window: tuple[float, float],
-                 period: Optional[float] = None, tolerance: float = 0.15) -> dict[str, Any]:
+                 period: Optional[float] = None, tolerance: float = 0.10) -> dict[str, Any]:
     """How steady the window is: events and hazard (Σ −ln(1 − P_k), both partners) per second
     in its first and second half, their ratio, and the Poisson z = (n_2 − n_1)/√(n_1 + n_2)
     of the event counts; and, when the window holds at least two whole ``period`` s (the
-    gate's), the events and hazard of each period (``period_events``, ``period_hazard``) and
-    their largest relative deviation from the mean (``deviation``, ``hazard_deviation``).
+    gate's, counted from its start), the events and hazard of each period (``period_events``,
+    ``period_hazard``) and the relative standard error of their means (``relative_error``,
+    ``hazard_relative_error``: s/(√N mean), the statistical uncertainty of the rate and of
+    the hourly risk from the window's length).
 
-    ``steady``: with periods, every period's events within ``tolerance`` of their mean (the
-    rate swings within a gate period, so only whole periods compare); without, |z| < 2 (no
-    drift detectable at the 95 % level)."""
+    ``steady``: with periods, the events' relative standard error at most ``tolerance`` (the
+    rate swings within a gate period and wanders over several, so only whole periods count
+    and only their scatter measures the uncertainty); without, |z| < 2."""
+    from demfem.studies.steady import period_rates, relative_error
+
     t0, t1 = window
     mid = 0.5 * (t0 + t1)
     half = 0.5 * (t1 - t0)
@@ -187,19 +191,14 @@ def steady_state(events: np.ndarray, p_event: np.ndarray, window: tuple[float, f
         "hazard_ratio": h2 / h1 if h1 > 0 else math.nan}
     n_periods = int(math.floor((t1 - t0) / period + 1e-9)) if period else 0
     if period and n_periods >= 2:
-        edges = t1 - period * np.arange(n_periods, -1, -1)
-        counts = np.histogram(t, edges)[0].astype(float)
-        hz = np.histogram(t, edges, weights=h)[0]
-
-        def deviation(x: np.ndarray) -> float:
-            m = float(np.mean(x))
-            return float(np.max(np.abs(x / m - 1.0))) if m > 0 else math.inf
-
+        counts = period_rates(t, t0, period, n_periods)
+        hz = period_rates(t, t0, period, n_periods, weights=h)
+        err = relative_error(counts)
         out.update({"period_s": float(period), "period_events": [int(c) for c in counts],
                     "period_hazard": [float(x) for x in hz],
-                    "deviation": deviation(counts), "hazard_deviation": deviation(hz),
+                    "relative_error": err, "hazard_relative_error": relative_error(hz),
                     "tolerance": float(tolerance), "criterion": "periods",
-                    "steady": bool(deviation(counts) <= tolerance)})
+                    "steady": bool(err <= tolerance)})
     return out
 
 

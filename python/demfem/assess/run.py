@@ -33,26 +33,27 @@ __all__ = ["assess", "OUTPUT_FILES", "QUICK_DURATION", "DEFAULT_DURATION", "FULL
            "steady_rule"]
 
 #: Longest simulated time of the default run, s: it runs until the collision rate is steady
-#: (:func:`steady_rule`: two gate periods within 15 %), at most this long.
-DEFAULT_DURATION = 12.0
+#: (:func:`steady_rule`: the mean impacts per gate period known to 10 %), at most this long.
+DEFAULT_DURATION = 24.0
 #: ``quick``: a fixed 0.1 s smoke run, statistics over its second half.
 QUICK_DURATION = 0.1
-#: ``full``: until four gate periods agree within 10 %, at most this long, s (docs/assess.md
-#: gives the measured difference from the default).
-FULL_DURATION = 30.0
+#: ``full``: until the mean is known to 5 % (at least 8 periods), at most this long, s
+#: (docs/assess.md gives the measured difference from the default).
+FULL_DURATION = 60.0
 
 
 def steady_rule(table, full: bool = False, min_speed: float = DEFAULT_MIN_SPEED):
     """The :class:`demfem.studies.steady.SteadyRule` of an assessment of ``table``: periods
-    of the gate (1 s for a still gate), after a 2 s warm-up, two periods within 15 % (``full``:
-    four within 10 %), impacts as the events stage counts them (not the belt)."""
+    of the gate (1 s for a still gate) counted from a 2 s warm-up, at least 4 of them and the
+    relative standard error of their mean impacts at most 10 % (``full``: 8 and 5 %),
+    impacts as the events stage counts them (not the belt)."""
     from demfem.assess.events import NOT_IMPACTS
     from demfem.studies.steady import SteadyRule
 
     names = [str(w["name"]) for w in table.build().walls]
     return SteadyRule(period=float(table.gate_period) if table.gate_amplitude > 0 else 1.0,
-                      window_periods=4 if full else 2, warmup=2.0,
-                      tolerance=0.10 if full else 0.15, min_speed=min_speed,
+                      min_periods=8 if full else 4, warmup=2.0,
+                      tolerance=0.05 if full else 0.10, min_speed=min_speed,
                       excluded_walls=tuple(k for k, n in enumerate(names) if n in NOT_IMPACTS))
 
 #: Files the job writes (removed by a fresh start), besides the DEM checkpoint.
@@ -263,13 +264,12 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
         f"{len(run.onsets)} contact onsets, wall {run.info['wall_time_s']:.1f} s")
     end = float(run.info["duration"])
     if rule is not None:
-        # the statistics window: the periods the rule compared (the last ones if the run
-        # reached its longest duration unsteady)
-        t0 = max(end - rule.window, 0.0)
+        # the statistics window: every whole period since the warm-up
+        t0 = min(rule.warmup, end)
         check = run.info.get("steady") or {}
         log(f"  {'steady' if check.get('steady') else 'NOT steady'} at t = {end:g} s: impacts "
-            f"per {rule.period:g} s period {check.get('counts')} (largest deviation "
-            f"{check.get('deviation', float('nan')):.1%}, tolerance {rule.tolerance:.0%})")
+            f"per {rule.period:g} s period {check.get('counts')} (standard error of the mean "
+            f"{check.get('relative_error', float('nan')):.1%}, tolerance {rule.tolerance:.0%})")
     if stop_after == "dem":
         return {"stopped_after": "dem"}
 
