@@ -3,25 +3,15 @@
 //! uninterrupted one (tangential history included); the AVX2 and baseline builds of the
 //! step kernels agree bitwise, and so do the batched and the one-contact-at-a-time kernels.
 
+mod dem_support;
+use dem_support::bits;
+
 use demfem::contact::reissner_stiffness;
 use demfem::dem::table::{anchor_scene, TableStart};
 use demfem::dem::{
     ContactModel, Effect, EffectSet, Material, ParticleInit, Partner, Scene, Simulation,
 };
 use demfem::geometry::{Vec3, WallMotion};
-
-fn bits(sim: &Simulation) -> Vec<u64> {
-    let mut out = Vec::new();
-    for v in sim
-        .positions()
-        .iter()
-        .chain(sim.velocities())
-        .chain(sim.angular_velocities())
-    {
-        out.extend([v.x.to_bits(), v.y.to_bits(), v.z.to_bits()]);
-    }
-    out
-}
 
 /// The packed anchor table (840 spheres, above the parallel threshold) at E = 1e8 Pa so that
 /// 3000 steps see real contact dynamics (belt drag, friction, collisions with the funnel).

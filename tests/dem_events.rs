@@ -11,19 +11,6 @@ use demfem::dem::table::{anchor_scene, TableStart};
 use demfem::dem::{ContactEvent, Effect, EffectSet, ParticleInit, Partner, Scene, Simulation};
 use demfem::geometry::Vec3;
 
-fn bits(sim: &Simulation) -> Vec<u64> {
-    let mut out = Vec::new();
-    for v in sim
-        .positions()
-        .iter()
-        .chain(sim.velocities())
-        .chain(sim.angular_velocities())
-    {
-        out.extend([v.x.to_bits(), v.y.to_bits(), v.z.to_bits()]);
-    }
-    out
-}
-
 /// Two equal spheres closing head-on at `v` (each at v/2), no walls, no gravity.
 fn head_on(e: f64, rest: f64, v: f64) -> (Scene, f64, f64) {
     let (r, rho) = (0.008, 2230.0);

@@ -2,7 +2,7 @@
 //! of `demfem::contact`, and small scene builders.
 #![allow(dead_code)]
 
-use demfem::dem::{EffectSet, Material, ParticleInit, Scene};
+use demfem::dem::{EffectSet, Material, ParticleInit, Scene, Simulation};
 use demfem::geometry::{Vec3, Wall, WallShape};
 
 /// Hertz stiffness k_H = 4/3 E* √R* (Johnson, Contact Mechanics, eq. 4.22).
@@ -117,4 +117,19 @@ pub fn jammed_box(nx: usize, ny: usize, young_modulus: f64) -> Scene {
         Effect::Planar,
     ]);
     Scene::new(particles, vec![glass], walls, effects)
+}
+
+/// The bits of every position, velocity and angular velocity: equal exactly when two runs
+/// are bitwise the same.
+pub fn bits(sim: &Simulation) -> Vec<u64> {
+    let mut out = Vec::new();
+    for v in sim
+        .positions()
+        .iter()
+        .chain(sim.velocities())
+        .chain(sim.angular_velocities())
+    {
+        out.extend([v.x.to_bits(), v.y.to_bits(), v.z.to_bits()]);
+    }
+    out
 }
