@@ -60,6 +60,21 @@ class ShellMesh:
     triangles: np.ndarray
     thickness: np.ndarray
 
+    @property
+    def n_nodes(self) -> int:
+        return int(self.nodes.shape[0])
+
+    @property
+    def n_elements(self) -> int:
+        return int(self.triangles.shape[0])
+
+    def placed(self, rotation: Optional[np.ndarray] = None,
+               translation: Sequence[float] = (0.0, 0.0, 0.0)) -> "ShellMesh":
+        """The mesh rotated by the 3×3 proper rotation ``rotation`` about the origin, then
+        moved by ``translation`` (m)."""
+        moved = TetMesh(self.nodes, np.zeros((0, 4), dtype=np.int64)).placed(rotation, translation)
+        return ShellMesh(moved.nodes, self.triangles, self.thickness)
+
 
 def rotation_about(axis: Sequence[float], angle_deg: float) -> np.ndarray:
     """Rotation matrix (3×3) by ``angle_deg`` degrees about ``axis`` (right-hand rule)."""
