@@ -60,7 +60,7 @@ use crate::error::{check_non_negative, check_positive, DemfemError, Result};
 use crate::fem::material::LinearElastic;
 use crate::fem::mesh::TetMesh;
 
-use vec3::{add, cross, dot, norm, scale, sub, tangential};
+use vec3::{add, dot, norm, scale, sub, tangential};
 
 /// Surface nodes per parallel work item (fixed, so results do not depend on the threads).
 const NODE_CHUNK: usize = 512;
@@ -210,6 +210,8 @@ pub struct ContactModel {
     offset: Vec<f64>,
     x: Vec<[f64; 3]>,
     touched: Vec<usize>,
+    // Per face, this step: unit normal, area ×2 and a bounding sphere (see `narrow`).
+    face_geom: Vec<narrow::FaceGeom>,
     f_prev: Vec<[f64; 3]>,
     u_prev: Vec<[f64; 3]>,
     normal_load: Vec<f64>,
@@ -305,6 +307,7 @@ impl ContactModel {
             offset: vec![0.0; ns],
             x: vec![[0.0; 3]; n],
             touched: surface.nodes.clone(),
+            face_geom: Vec::new(),
             f_prev: vec![[0.0; 3]; n],
             u_prev: vec![[0.0; 3]; n],
             normal_load: vec![0.0; ns],
@@ -464,11 +467,12 @@ impl ContactModel {
     /// Error for bodies that overlap at the start by more than the tolerance.
     pub fn check_initial_overlap(&mut self, u: &[[f64; 3]]) -> Result<()> {
         self.update_positions(u);
+        self.update_face_geometry();
         self.broad.rebuild(&self.surface, &self.x, u);
         let tol = self.settings.initial_overlap_tolerance;
         for k in 0..self.surface.nodes.len() {
             // At the start the whole element's height counts, to catch overlaps.
-            if let Some((f, d, _, _)) = self.closest_face(k, 1.0) {
+            if let Some((f, d, _, _, _)) = self.closest_face(k, 1.0) {
                 if d > tol {
                     let face = &self.surface.faces[f];
                     return Err(DemfemError::InvalidParameter {
@@ -507,21 +511,12 @@ impl ContactModel {
         }
     }
 
-    /// Unit normal of `face` now and the velocity (m/s) of its point with barycentric
-    /// weights `w`.
-    fn face_normal_and_velocity(
-        &self,
-        face: &SurfaceFace,
-        w: [f64; 3],
-        v: &[[f64; 3]],
-    ) -> ([f64; 3], [f64; 3]) {
-        let [a, b, c] = face.nodes.map(|j| self.x[j]);
-        let nrm = cross(sub(b, a), sub(c, a));
-        let vf = add(
+    /// The velocity (m/s) of the point of `face` with barycentric weights `w`.
+    fn face_velocity(&self, face: &SurfaceFace, w: [f64; 3], v: &[[f64; 3]]) -> [f64; 3] {
+        add(
             add(scale(v[face.nodes[0]], w[0]), scale(v[face.nodes[1]], w[1])),
             scale(v[face.nodes[2]], w[2]),
-        );
-        (scale(nrm, 1.0 / norm(nrm)), vf)
+        )
     }
 
     /// Contact and spring forces (N, added into `force`, one per node) at displacement `u`
@@ -536,6 +531,7 @@ impl ContactModel {
         force: &mut [[f64; 3]],
     ) {
         self.update_positions(u);
+        self.update_face_geometry();
         if self.broad.needs_rebuild(&self.surface, u) {
             self.broad.rebuild(&self.surface, &self.x, u);
         }
@@ -555,10 +551,9 @@ impl ContactModel {
                     let mut out = Vec::new();
                     for k in k0..k1 {
                         let i = this.surface.nodes[k];
-                        if let Some((f, d, w, side)) = this.closest_face(k, 0.5) {
+                        if let Some((f, d, w, side, n)) = this.closest_face(k, 0.5) {
                             let face = &this.surface.faces[f];
-                            let (n, vf) = this.face_normal_and_velocity(face, w, v);
-                            let n = scale(n, side);
+                            let vf = this.face_velocity(face, w, v);
                             let vrel = sub(v[i], vf);
                             // A node in contact within the last few steps may come back at
                             // any depth the face takes (it lost the face for a step at an

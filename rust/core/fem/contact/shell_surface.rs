@@ -71,8 +71,8 @@ impl Surface {
                 body: b,
                 stiffness: penalty_scale * youngs_modulus * t,
                 // The reach of the face: its own half thickness plus that of the thickest
-                // node that can meet it, on both sides (the broad phase inflates by it).
-                depth: t + t_max,
+                // node that can meet it, on either side (the broad phase inflates by it).
+                depth: 0.5 * (t + t_max),
                 area,
                 half_thickness: 0.5 * t,
             });
