@@ -453,6 +453,13 @@ impl ContactModel {
             spring_row[s.node] += s.stiffness / mass[s.node];
         }
         let spring_term = spring_row.iter().fold(0.0f64, |a, &b| a.max(b));
+        // A shell node is a slave and, at a ridge met head-on, the corner its own faces give
+        // weight 1 to another body's slave: two full-stiffness springs per node.
+        let face_term = if self.is_shell() {
+            2.0 * face_term
+        } else {
+            face_term
+        };
         let allowance = self.settings.contacts_per_node * face_term + rigid_term + spring_term;
         if !allowance.is_finite() {
             return Err(DemfemError::Numerical(
