@@ -187,7 +187,7 @@ def _simulate(cluster: CartridgeCluster, duration: float, n_snapshots: int, out:
     e1 = model.body_elements(0)
     n1 = model.body_nodes(0)
     shell = cluster.elements == "shell"
-    kind = ("shell triangles (σ1 on the inner and outer faces; no VTK files)" if shell else
+    kind = ("shell triangles (σ1 on the inner and outer faces, no VTK files" if shell else
             f"tets ({cluster.layers} through the wall")
     log(f"cluster: {model.mesh.n_elements} {kind}, "
         f"n_theta = {parts.n_theta}), dt = {model.dt_step:.3g} s, about "
