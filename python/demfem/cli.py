@@ -435,7 +435,7 @@ def build_parser() -> argparse.ArgumentParser:
     cl.add_argument("--springs", action="store_true",
                     help="hold 4-7 by no-tension springs to ghost neighbours")
     cl.add_argument("--elements", default=None, choices=("tet", "shell"),
-                    help="element type (tet; shell has no contact solver yet)")
+                    help="element type: tet (layers through the wall) or shell (mid-surface, contact on both faces)")
     cl.add_argument("--layers", type=int, default=None,
                     help="tet layers through the wall, 1-4 (2)")
     cl.add_argument("--duration", type=float, default=3e-3, help="simulated time, s (3e-3)")

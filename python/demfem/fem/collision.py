@@ -7,14 +7,14 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
-from typing import Optional
+from typing import Any, Optional
 
 import numpy as np
 
 from demfem.cartridge import Cartridge
 from demfem.contact import ContactBody, hertz_contact_duration
 from demfem.errors import InvalidParameterError, check_positive, check_range
-from demfem.fem.mesh import cartridge_tet_mesh, rotation_about
+from demfem.fem.mesh import cartridge_shell_mesh, cartridge_tet_mesh, rotation_about
 from demfem.fem.model import Body, ContactOptions, FemModel
 from demfem.fem.result import FemResult, moving_average
 from demfem.materials import Material
@@ -69,25 +69,39 @@ def collide_cartridges(a: Optional[Cartridge] = None, b: Optional[Cartridge] = N
     configuration). ``b`` closes on ``a`` at ``v_rel`` (m/s) along x; no gravity, no belt.
     ``material`` defaults to ``a``'s glass. ``layers``: elements through the wall.
     ``stress_samples``: how many times over the expected contact to sample σ1 on ``a``'s
-    surfaces (0: not at all).
+    surfaces (0: not at all). ``elements``: "tet" (``layers`` through the wall) or "shell"
+    (mid-surface triangles; contact on both faces, half the wall thickness off the
+    mid-surface; σ1 on the inner and outer faces).
     """
     a = a or Cartridge()
     b = b or a
     mat = material or a.material
     v_rel = check_range("v_rel", v_rel, 1e-6, 100.0)
     tilt = check_range("tilt_deg", tilt_deg, 0.0, 90.0, lo_open=False, hi_open=False)
-    if elements != "tet":
-        raise InvalidParameterError(
-            f"invalid elements = {elements!r}: contact runs on 'tet' meshes (shell meshes have "
-            "no explicit contact solver in demfem yet)")
-    ma = cartridge_tet_mesh(a, layers=layers, target_size=target_size)
-    mb = cartridge_tet_mesh(b, layers=layers, target_size=target_size)
+    if elements not in ("tet", "shell"):
+        raise InvalidParameterError(f"invalid elements = {elements!r}: must be 'tet' or 'shell'")
+    shell = elements == "shell"
+    ma: Any
+    mb: Any
+    if shell:
+        ma = cartridge_shell_mesh(a, target_size=target_size)
+        mb = cartridge_shell_mesh(b, target_size=target_size)
+    else:
+        ma = cartridge_tet_mesh(a, layers=layers, target_size=target_size)
+        mb = cartridge_tet_mesh(b, layers=layers, target_size=target_size)
     # Turn each tube about its own axis by half a division, so a face (not an edge of the
     # faceted surface) faces the other tube: node-to-surface contact does not see two
     # edges crossing (that needs edge-to-edge contact, which demfem does not have).
     ma = ma.placed(rotation_about((0.0, 0.0, 1.0), 0.5 * _division_deg(ma)))
     mb = mb.placed(rotation_about((0.0, 0.0, 1.0), 180.0 + 0.5 * _division_deg(mb)))
     za, zb = 0.5 * a.body_length, 0.5 * b.body_length
+    if shell:
+        # A shell has no nodes through the wall, only rings on the mid-surface: centre each
+        # on its node ring nearest the body's middle, so that the crossed tubes meet with
+        # nodes of each on the other's faces (face centres against face centres would be an
+        # edge-to-edge crossing, which node-to-surface contact does not see).
+        za, zb = (float(min(np.unique(m.nodes[:, 2]), key=lambda z: abs(z - zc)))
+                  for m, zc in ((ma, za), (mb, zb)))
     ra, rb = 0.5 * a.body_outer_diameter, 0.5 * b.body_outer_diameter
     gap = 1e-3 * min(a.wall_thickness, b.wall_thickness)
     mesh_a = ma.placed(None, (0.0, 0.0, -za))
@@ -95,8 +109,10 @@ def collide_cartridges(a: Optional[Cartridge] = None, b: Optional[Cartridge] = N
     # b is centred on its body's middle, turned about x, then moved out along x.
     mesh_b = mb.placed(None, (0.0, 0.0, -zb)).placed(rot, (ra + rb + gap, 0.0, 0.0))
     # The faceted surfaces lie inside the circles: close the extra clearance so that the
-    # meshes start `gap` apart along x.
-    shift = float(mesh_b.nodes[:, 0].min() - mesh_a.nodes[:, 0].max()) - gap
+    # meshes start `gap` apart along x (shells: their contact surfaces, half the wall
+    # thickness off the mid-surface nodes).
+    offset = 0.5 * (a.wall_thickness + b.wall_thickness) if shell else 0.0
+    shift = float(mesh_b.nodes[:, 0].min() - mesh_a.nodes[:, 0].max()) - gap - offset
     mesh_b = mesh_b.placed(None, (-shift, 0.0, 0.0))
     model = FemModel(
         bodies=[Body(mesh_a, name="a"), Body(mesh_b, velocity=(-v_rel, 0.0, 0.0), name="b")],
@@ -118,11 +134,26 @@ def collide_cartridges(a: Optional[Cartridge] = None, b: Optional[Cartridge] = N
     outer = np.nonzero(body_a & (r_a > r_body.max() * (1 - 1e-9)))[0]
     peaks = {"inner": 0.0, "outer": 0.0, "next": 0.0}
     every = t_est / stress_samples if stress_samples > 0 else math.inf
+    if shell:
+        # a's triangles on its cylindrical body, and which of their faces is the outer one.
+        tri = mesh_a.triangles
+        cen = mesh_a.nodes[tri].mean(axis=1)
+        on_body = np.nonzero(np.abs(cen[:, 2]) < 0.45 * a.body_length)[0]
+        normals = np.asarray(model.solver.triangle_normals())[on_body]
+        radial = cen[on_body] * np.array([1.0, 1.0, 0.0])
+        top_out = np.einsum("ij,ij->i", normals, radial) > 0
 
     def sample_stress(m: FemModel) -> None:
         if m.time < peaks["next"]:
             return
         peaks["next"] = m.time + every
+        if shell:
+            s = np.asarray(m.solver.surface_sigma1())[on_body]
+            out_s = np.where(top_out, s[:, 2], s[:, 0])
+            in_s = np.where(top_out, s[:, 0], s[:, 2])
+            peaks["inner"] = max(peaks["inner"], float(in_s.max(initial=0.0)))
+            peaks["outer"] = max(peaks["outer"], float(out_s.max(initial=0.0)))
+            return
         from demfem import _core
         ns = np.asarray(m.solver.nodal_stresses())[: mesh_a.n_nodes]
         p, _ = _core.fem_stress_invariants(np.ascontiguousarray(ns[np.concatenate([inner, outer])]))

@@ -1,23 +1,24 @@
-"""An explicit FEM model of several bodies in contact: tetrahedral bodies placed in space
-with initial velocities, rigid surfaces (the belt: a plane whose surface moves, with
+"""An explicit FEM model of several bodies in contact: tetrahedral or shell bodies placed in
+space with initial velocities, rigid surfaces (the belt: a plane whose surface moves, with
 friction; spheres and cylinders for tests), no-tension springs to ghost points, gravity.
 
-The bodies are joined into one mesh for the Rust solver (``demfem._core.FemTetSolver``),
-which integrates them with central differences and penalty contact (see
-``rust/core/fem/contact``). All quantities are SI: m, s, kg, N, Pa.
+The bodies are joined into one mesh for the Rust solver (``demfem._core.FemTetSolver``, or
+``demfem._core.FemShellSolver`` when every body is a :class:`ShellMesh`), which integrates
+them with central differences and penalty contact (see ``rust/core/fem/contact``; shells:
+two-sided faces offset by half the thickness, penalty s·E·t). All quantities are SI: m, s, kg, N, Pa.
 """
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Optional, Sequence, Union
+from typing import Any, Callable, Optional, Sequence, Union
 
 import numpy as np
 
 from demfem import _core
 from demfem.errors import InvalidParameterError, check_positive, check_range
-from demfem.fem.mesh import TetMesh
+from demfem.fem.mesh import ShellMesh, TetMesh
 from demfem.fem.result import FemResult, Snapshot
 from demfem.materials import Material
 
@@ -35,11 +36,11 @@ def _friction(mu: float) -> float:
 
 @dataclass(frozen=True)
 class Body:
-    """A tetrahedral body: its mesh (already placed), initial velocity (m/s), a name for
-    the outputs, and optionally an output region per node (integers 0, 1, …; e.g. the top
-    and bottom halves of a cartridge)."""
+    """A body: its mesh (a :class:`TetMesh` or a :class:`ShellMesh`, already placed),
+    initial velocity (m/s), a name for the outputs, and optionally an output region per node
+    (integers 0, 1, …; e.g. the top and bottom halves of a cartridge)."""
 
-    mesh: TetMesh
+    mesh: Union[TetMesh, ShellMesh]
     velocity: Sequence[float] = (0.0, 0.0, 0.0)
     name: str = ""
     regions: Optional[np.ndarray] = None
@@ -161,10 +162,27 @@ class FemModel:
                 raise InvalidParameterError(f"invalid body {b!r}: must be a demfem.fem.Body")
         offsets = np.cumsum([0] + [b.mesh.n_nodes for b in self.bodies])
         self.node_offsets = offsets
-        self.mesh = TetMesh(
-            np.vstack([b.mesh.nodes for b in self.bodies]),
-            np.vstack([b.mesh.tets + offsets[i] for i, b in enumerate(self.bodies)]).astype(np.int64),
-        )
+        kinds = {isinstance(b.mesh, ShellMesh) for b in self.bodies}
+        if len(kinds) != 1 or not all(isinstance(b.mesh, (TetMesh, ShellMesh)) for b in self.bodies):
+            raise InvalidParameterError(
+                "invalid bodies: all meshes must be TetMesh or all ShellMesh (no mixed models)")
+        self.elements = "shell" if kinds == {True} else "tet"
+        nodes = np.vstack([b.mesh.nodes for b in self.bodies])
+        shells = [b.mesh for b in self.bodies if isinstance(b.mesh, ShellMesh)]
+        tets = [b.mesh for b in self.bodies if isinstance(b.mesh, TetMesh)]
+        self.mesh: Union[TetMesh, ShellMesh]
+        if self.elements == "shell":
+            shell_mesh = ShellMesh(
+                nodes,
+                np.vstack([m.triangles + offsets[i] for i, m in enumerate(shells)]).astype(np.int64),
+                np.concatenate([np.asarray(m.thickness, dtype=float) for m in shells]))
+            self.mesh = shell_mesh
+        else:
+            tet_mesh = TetMesh(
+                nodes,
+                np.vstack([m.tets + offsets[i] for i, m in enumerate(tets)]).astype(np.int64),
+            )
+            self.mesh = tet_mesh
         n = self.mesh.n_nodes
         self.body_of_node = np.repeat(np.arange(len(self.bodies)), np.diff(offsets)).astype(np.int64)
         region = np.zeros(n, dtype=np.int64)
@@ -176,12 +194,21 @@ class FemModel:
                         f"invalid regions of body {i}: must be {b.mesh.n_nodes} integers >= 0")
                 region[offsets[i]:offsets[i + 1]] = r
         self.region_of_node = region
-        self._solver = _core.FemTetSolver(
-            self.mesh.nodes, self.mesh.tets, self.material.E, self.material.nu,
-            self.material.density, dt=self.dt, safety_factor=self.safety_factor,
-            rayleigh_alpha=self.rayleigh_alpha, rayleigh_beta=self.rayleigh_beta,
-            mass_scaling_dt=self.mass_scaling_dt, certified_step=self.certified_step,
-            energy_interval=0)
+        self._solver: Any
+        if self.elements == "shell":
+            self._check_shell_options()
+            self._solver = _core.FemShellSolver(
+                np.ascontiguousarray(shell_mesh.nodes, dtype=float),
+                np.ascontiguousarray(shell_mesh.triangles, dtype=np.int64),
+                np.ascontiguousarray(shell_mesh.thickness, dtype=float), self.material.E,
+                self.material.nu, self.material.density, dt=self.dt)
+        else:
+            self._solver = _core.FemTetSolver(
+                tet_mesh.nodes, tet_mesh.tets, self.material.E, self.material.nu,
+                self.material.density, dt=self.dt, safety_factor=self.safety_factor,
+                rayleigh_alpha=self.rayleigh_alpha, rayleigh_beta=self.rayleigh_beta,
+                mass_scaling_dt=self.mass_scaling_dt, certified_step=self.certified_step,
+                energy_interval=0)
         vel = np.zeros((n, 3))
         for i, b in enumerate(self.bodies):
             vel[offsets[i]:offsets[i + 1]] = _vec3(f"velocity of body {i}", b.velocity)
@@ -189,7 +216,10 @@ class FemModel:
         self.dt_without_contact = self._solver.dt
         if self.gravity is not None:
             g = np.asarray(_vec3("gravity", self.gravity))
-            self._solver.set_loads(np.asarray(self._solver.mass())[:, None] * g[None, :])
+            if self.elements == "shell":
+                self._solver.add_gravity((float(g[0]), float(g[1]), float(g[2])))
+            else:
+                self._solver.set_loads(np.asarray(self._solver.mass())[:, None] * g[None, :])
         sn, sa, sk, sl = self._spring_arrays()
         c = self.contact
         self._solver.set_contact(
@@ -200,6 +230,14 @@ class FemModel:
             spring_nodes=sn, spring_anchors=sa, spring_stiffness=sk, spring_rest_length=sl)
         self.party_names = [b.name or f"body{i}" for i, b in enumerate(self.bodies)] + \
             [r.name for r in self.rigid]
+
+    def _check_shell_options(self) -> None:
+        """The shell solver is undamped, unscaled, with a step of 0.9 × its certified bound."""
+        if self.rayleigh_alpha or self.rayleigh_beta or self.mass_scaling_dt is not None \
+                or self.safety_factor != 0.9 or not self.certified_step:
+            raise InvalidParameterError(
+                "invalid options for shell bodies: Rayleigh damping, mass scaling, another "
+                "safety_factor and an uncertified step are for tet bodies only")
 
     def _spring_arrays(self):
         if not self.springs:
@@ -226,8 +264,8 @@ class FemModel:
 
     # ------------------------------------------------------------------ state
     @property
-    def solver(self) -> "_core.FemTetSolver":
-        """The underlying Rust solver."""
+    def solver(self) -> Any:
+        """The underlying Rust solver (``_core.FemTetSolver`` or ``_core.FemShellSolver``)."""
         return self._solver
 
     @property
@@ -345,7 +383,14 @@ class FemModel:
         self._solver.restore_state(Path(path).read_bytes())
 
     def snapshot(self) -> Snapshot:
-        """The state now: displacement (N,3) m, element σ1 (E,) Pa, contact pressure (N,) Pa."""
+        """The state now: displacement (N,3) m, element σ1 (E,) Pa, contact pressure (N,) Pa
+        (shells: also σ1 (E,3) on the bottom, middle and top surfaces)."""
+        if self.elements == "shell":
+            s = np.asarray(self._solver.surface_sigma1())
+            return Snapshot(time=self.time, displacement=np.asarray(self._solver.displacement()),
+                            sigma1_element=np.maximum(s[:, 0], s[:, 2]),
+                            contact_pressure=np.asarray(self._solver.contact_pressure()),
+                            sigma1_surfaces=s)
         stress = np.asarray(self._solver.element_stresses())
         p, _ = _core.fem_stress_invariants(stress)
         return Snapshot(time=self.time, displacement=np.asarray(self._solver.displacement()),
@@ -354,5 +399,7 @@ class FemModel:
 
     def write_vtu(self, path: Union[str, Path]) -> None:
         """Write the current state (displacement, velocity, stresses, σ1, contact pressure)
-        to a VTK .vtu file."""
+        to a VTK .vtu file (tet bodies only)."""
+        if self.elements == "shell":
+            raise InvalidParameterError("invalid write_vtu: not available for shell bodies yet")
         self._solver.write_vtu(Path(path))

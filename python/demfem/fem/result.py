@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Sequence, Union
+from typing import TYPE_CHECKING, Optional, Sequence, Union
 
 import numpy as np
 
@@ -25,12 +25,15 @@ ENERGY_COLUMNS = ("time_s", "kinetic_J", "internal_J", "external_work_J", "dampi
 @dataclass(frozen=True)
 class Snapshot:
     """The fields at one instant: time (s), displacement (N,3) m, element σ1 (E,) Pa,
-    contact pressure per node (N,) Pa."""
+    contact pressure per node (N,) Pa (and for shells σ1 on both faces)."""
 
     time: float
     displacement: np.ndarray
     sigma1_element: np.ndarray
     contact_pressure: np.ndarray
+    #: Shells only: σ1 (E, 3) Pa at each triangle's bottom (−t/2 along its normal), middle
+    #: and top (+t/2) surfaces; ``sigma1_element`` is then the larger of bottom and top.
+    sigma1_surfaces: Optional[np.ndarray] = None
 
 
 @dataclass

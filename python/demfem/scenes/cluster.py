@@ -36,11 +36,17 @@ moves towards +x), y across it, z up; the belt is the rigid plane z = 0. Top vie
   contact stiffness of two cartridges, :func:`demfem.contact.k_eq` at the impact speed
   ``max(v2, v3)`` (eq. 15, Hertz linearised at that speed in series with both Reissner
   shells), divided evenly over the nodes of that column.
-* Meshes: ``elements = "tet"`` (``layers`` elements through the wall, 1-4); the number of
-  divisions around is rounded up to a multiple of 6 so that a node column of every
-  cartridge faces each of its six hexagon neighbours (vertex-to-vertex at the start, so
-  ``touch_gap`` is the true gap). ``"shell"`` is refused: shells have no explicit contact
-  solver in demfem yet.
+* Meshes: ``elements = "tet"`` (``layers`` elements through the wall, 1-4) or ``"shell"``
+  (flat CST + DKT triangles on the mid-surface, 6 dof per node; contact on both faces, half
+  the wall thickness off the mid-surface, penalty s·E·t; default element size 2 t, as
+  the tets' at one layer; ``layers`` is not used; each shell is lifted by half its end thickness, so
+  that its contact surface, not its mid-surface node, is ``lift`` above the belt; profile
+  stations closer than half the element size are merged, so the 0.3 mm crimp step becomes
+  a short cone: its ring of thin triangles would otherwise halve the stable step). The
+  number of divisions around is rounded up to a multiple of 6 so that a node column of
+  every cartridge faces each of its six hexagon neighbours (vertex-to-vertex at the start,
+  so ``touch_gap`` is the true gap between the contact surfaces). Shell runs have no
+  Rayleigh damping and no mass scaling (``mass_scaling_dt`` must be 0).
 * Contact output regions of cartridge 1: region 0 = its bottom half (z < length / 2),
   region 1 = its top half.
 
@@ -89,9 +95,9 @@ _UNITS = {
     "springs": "4-7 held by no-tension springs to ghost neighbours",
     "spring_stiffness": "N/m per ghost contact; 0 = the calibrated k_eq at max(v2, v3)",
     "spring_length": "m, rest length of the ghost springs",
-    "elements": "tet (shell: no contact solver yet)",
+    "elements": "tet or shell",
     "layers": "tet elements through the wall, 1-4",
-    "target_size": "m, element size along and around; 0 = 2 t / layers",
+    "target_size": "m, element size along and around; 0 = 2 t / layers (shells: 2 t)",
     "belt_speed": "m/s along +x",
     "belt_friction": "Coulomb coefficient, cartridge-belt",
     "friction": "Coulomb coefficient, cartridge-cartridge",
@@ -167,14 +173,9 @@ class CartridgeCluster:
         for name in ("direction_2_deg", "direction_3_deg"):
             check_range(name, getattr(self, name), -360.0, 360.0, lo_open=False, hi_open=False)
         object.__setattr__(self, "springs", _flag("springs", self.springs))
-        if self.elements == "shell":
+        if self.elements not in ("tet", "shell"):
             raise InvalidParameterError(
-                "invalid elements = 'shell': shell meshes have no explicit contact solver in "
-                "demfem yet; use elements = 'tet'")
-        if self.elements != "tet":
-            raise InvalidParameterError(
-                f"invalid elements = {self.elements!r}: must be 'tet' ('shell' is not "
-                "available: no shell contact solver yet)")
+                f"invalid elements = {self.elements!r}: must be 'tet' or 'shell'")
         if isinstance(self.layers, bool) or not isinstance(self.layers, (int, np.integer)) \
                 or not 1 <= self.layers <= 4:
             raise InvalidParameterError(
@@ -192,6 +193,10 @@ class CartridgeCluster:
         check_range("touch_tolerance", self.touch_tolerance, 0.0, 1e-3)
         check_range("penalty_scale", self.penalty_scale, 0.0, 1e3)
         check_range("mass_scaling_dt", self.mass_scaling_dt, 0.0, 1e-3, lo_open=False)
+        if self.elements == "shell" and self.mass_scaling_dt > 0:
+            raise InvalidParameterError(
+                f"invalid mass_scaling_dt = {self.mass_scaling_dt!r} with elements = 'shell': "
+                "the shell solver has no mass scaling (must be 0)")
         check_range("lift", self.lift, 0.0, 1e-3, lo_open=False)
         if not isinstance(self.cartridge, Cartridge):
             raise InvalidParameterError(
@@ -322,8 +327,11 @@ class CartridgeCluster:
         return int(6 * math.ceil(n / 6))
 
     def element_size(self) -> float:
-        return float(self.target_size) if self.target_size > 0 else \
-            2.0 * self.cartridge.wall_thickness / self.layers
+        """``target_size`` if set, else 2 t / layers for tets and 2 t for shells (m)."""
+        if self.target_size > 0:
+            return float(self.target_size)
+        layers = 1 if self.elements == "shell" else self.layers
+        return 2.0 * self.cartridge.wall_thickness / layers
 
     def ghost_stiffness(self) -> float:
         """Stiffness of one ghost contact, N/m: ``spring_stiffness`` if set, else the
@@ -337,16 +345,27 @@ class CartridgeCluster:
 
     def parts(self) -> ClusterParts:
         """Meshes, velocities, regions and springs of the cluster (no solver yet)."""
-        from demfem.fem.mesh import cartridge_tet_mesh
+        from demfem.fem.mesh import cartridge_shell_mesh, cartridge_tet_mesh
         from demfem.fem.model import GhostSprings
 
         c = self.cartridge
         n_theta = self.n_theta()
-        base = cartridge_tet_mesh(c, layers=int(self.layers), target_size=self.element_size(),
-                                  n_theta=n_theta)
+        shell = self.elements == "shell"
+        base: Any
+        if shell:
+            base = cartridge_shell_mesh(c, target_size=self.element_size(), n_theta=n_theta,
+                                        min_station_gap=0.5 * self.element_size())
+            # The open end's ring carries half its thickness below it (its contact surface).
+            bottom = np.unique(base.triangles[np.any(base.nodes[base.triangles][:, :, 2] <= 1e-12, axis=1)])
+            tri_b = np.any(np.isin(base.triangles, bottom), axis=1)
+            z0 = 0.5 * float(np.max(base.thickness[tri_b]))
+        else:
+            base = cartridge_tet_mesh(c, layers=int(self.layers), target_size=self.element_size(),
+                                      n_theta=n_theta)
+            z0 = 0.0
         centres = self.centres()
-        meshes = [base.placed(None, (float(x), float(y), float(self.lift))) for x, y in centres]
-        regions_1 = (meshes[0].nodes[:, 2] >= self.lift + 0.5 * c.length).astype(np.int64)
+        meshes = [base.placed(None, (float(x), float(y), float(self.lift) + z0)) for x, y in centres]
+        regions_1 = (meshes[0].nodes[:, 2] >= self.lift + z0 + 0.5 * c.length).astype(np.int64)
         springs = []
         k_contact = 0.0
         if self.springs:
@@ -355,7 +374,9 @@ class CartridgeCluster:
             rel = base.nodes
             r = np.hypot(rel[:, 0], rel[:, 1])
             theta = np.degrees(np.arctan2(rel[:, 1], rel[:, 0]))
-            outer = (np.abs(r - ro) < 1e-6 * ro) & (rel[:, 2] <= c.body_length + 1e-12)
+            # The outer surface's nodes (shells: the body's mid-surface nodes).
+            r_col = ro - 0.5 * c.wall_thickness if shell else ro
+            outer = (np.abs(r - r_col) < 1e-6 * ro) & (rel[:, 2] <= c.body_length + 1e-12)
             half = 0.5 * 360.0 / n_theta
             for k in range(3, 7):  # cartridges 4-7 (index 3..6)
                 phi = SITE_ANGLES_DEG[k - 1]

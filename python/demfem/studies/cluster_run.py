@@ -186,7 +186,10 @@ def _simulate(cluster: CartridgeCluster, duration: float, n_snapshots: int, out:
     build_s = _time.perf_counter() - t_build
     e1 = model.body_elements(0)
     n1 = model.body_nodes(0)
-    log(f"cluster: {model.mesh.n_elements} tets ({cluster.layers} through the wall, "
+    shell = cluster.elements == "shell"
+    kind = ("shell triangles (σ1 on the inner and outer faces, no VTK files" if shell else
+            f"tets ({cluster.layers} through the wall")
+    log(f"cluster: {model.mesh.n_elements} {kind}, "
         f"n_theta = {parts.n_theta}), dt = {model.dt_step:.3g} s, about "
         f"{int(math.ceil(duration / model.dt_step))} steps; springs: {cluster.springs}")
     bar = None
@@ -226,12 +229,16 @@ def _simulate(cluster: CartridgeCluster, duration: float, n_snapshots: int, out:
                 r = model.run(left, progress=cb)
                 if r.energy.size:
                     energy.append(r.energy)
-            stress = np.asarray(model.solver.element_stresses())[e1]
-            p1, _ = _core.fem_stress_invariants(np.ascontiguousarray(stress))
+            if shell:
+                s1 = _shell_sigma1(model, e1, parts.meshes[0])
+            else:
+                stress = np.asarray(model.solver.element_stresses())[e1]
+                p1, _ = _core.fem_stress_invariants(np.ascontiguousarray(stress))
+                s1 = np.asarray(p1)[:, 0]
             snaps_t.append(model.time)
-            sig.append(np.asarray(p1)[:, 0].astype(np.float32))
+            sig.append(s1.astype(np.float32))
             press.append(np.asarray(model.solver.contact_pressure())[n1].astype(np.float32))
-            if t_target in vtk_set:
+            if t_target in vtk_set and not shell:
                 name = f"cluster_{len(frames):04d}.vtu"
                 model.write_vtu(vtk / name)
                 frames.append((model.time, f"vtk/{name}"))
@@ -265,7 +272,8 @@ def _simulate(cluster: CartridgeCluster, duration: float, n_snapshots: int, out:
     data.update({
         "snap_time": np.asarray(snaps_t), "sigma1": np.asarray(sig),
         "pressure": np.asarray(press),
-        "nodes_1": mesh1.nodes, "tets_1": mesh1.tets,
+        "nodes_1": mesh1.nodes,
+        **({"tris_1": mesh1.triangles} if shell else {"tets_1": mesh1.tets}),
         "stats": np.array([wall, steps, model.dt_step, model.mesh.n_elements, build_s,
                            res.energy_balance_error(), parts.spring_stiffness_per_contact,
                            parts.n_theta], float),
@@ -274,8 +282,51 @@ def _simulate(cluster: CartridgeCluster, duration: float, n_snapshots: int, out:
     return data
 
 
+def _outer_is_top(mesh: Any) -> np.ndarray:
+    """Per triangle of a placed shell mesh of one cartridge: whether its top face (+t/2
+    along its right-hand normal) is the outer surface (the normal points away from the axis)."""
+    x = mesh.nodes[mesh.triangles]
+    n = np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])
+    cen = x.mean(axis=1)
+    axis = mesh.nodes[:, :2].mean(axis=0)
+    radial = np.column_stack([cen[:, 0] - axis[0], cen[:, 1] - axis[1], np.zeros(len(cen))])
+    return np.einsum("ij,ij->i", n, radial) > 0
+
+
+def _shell_sigma1(model: Any, e1: slice, mesh1: Any) -> np.ndarray:
+    """σ1 of cartridge 1's triangles: (2T,) Pa, the inner faces, then the outer faces."""
+    s = np.asarray(model.solver.surface_sigma1())[e1]
+    top_out = _outer_is_top(mesh1)
+    inner = np.where(top_out, s[:, 0], s[:, 2])
+    outer = np.where(top_out, s[:, 2], s[:, 0])
+    return np.concatenate([inner, outer])
+
+
 # ---------------------------------------------------------------------- outputs
+def _shell_geometry(cluster: CartridgeCluster, data: dict) -> dict:
+    """As :func:`_geometry` for shells: the entries are the inner faces of 1's triangles,
+    then their outer faces (r = the inner and outer radius of the wall)."""
+    nodes, tris = data["nodes_1"], data["tris_1"].astype(np.int64)
+    c = cluster.cartridge
+    cen = nodes[tris].mean(axis=1)
+    zc = cen[:, 2] - cluster.lift
+    ri, ro = c.radii_at(np.clip(zc, 0.0, c.length))
+    body = zc <= c.body_length
+    nt = len(tris)
+    two = lambda a: np.concatenate([a, a])  # noqa: E731
+    theta = np.degrees(np.arctan2(cen[:, 1], cen[:, 0]))
+    return {
+        "theta": two(theta), "r": np.concatenate([ri, ro]), "z": two(zc),
+        "outer": np.concatenate([np.zeros(nt, bool), body]),
+        "inner": np.concatenate([body, np.zeros(nt, bool)]),
+        "bottom": two(zc < 0.5 * c.length), "body": two(body),
+        "dtheta": 360.0 / float(data["stats"][7]),
+    }
+
+
 def _geometry(cluster: CartridgeCluster, data: dict) -> dict:
+    if "tris_1" in data:
+        return _shell_geometry(cluster, data)
     nodes, tets = data["nodes_1"], data["tets_1"].astype(np.int64)
     c = cluster.cartridge
     cen = nodes[tets].mean(axis=1)

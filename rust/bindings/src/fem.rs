@@ -19,9 +19,9 @@ use crate::fem_contact::{self, PyRigid};
 use crate::PyDemfemError;
 use demfem::fem::contact::ContactSettings;
 
-type Nodes<'py> = Bound<'py, PyArray2<f64>>;
+pub(crate) type Nodes<'py> = Bound<'py, PyArray2<f64>>;
 
-fn shape_err(field: &str, detail: String) -> PyErr {
+pub(crate) fn shape_err(field: &str, detail: String) -> PyErr {
     PyDemfemError::from(DemfemError::ShapeMismatch {
         field: field.into(),
         detail,
@@ -29,7 +29,7 @@ fn shape_err(field: &str, detail: String) -> PyErr {
     .into()
 }
 
-fn rows3(a: &PyReadonlyArray2<'_, f64>, field: &str) -> PyResult<Vec<[f64; 3]>> {
+pub(crate) fn rows3(a: &PyReadonlyArray2<'_, f64>, field: &str) -> PyResult<Vec<[f64; 3]>> {
     let v = a.as_array();
     if v.ncols() != 3 {
         return Err(shape_err(
@@ -66,7 +66,7 @@ fn to_mesh(
     Ok(mesh)
 }
 
-fn arr3<'py>(py: Python<'py>, v: &[[f64; 3]]) -> PyResult<Nodes<'py>> {
+pub(crate) fn arr3<'py>(py: Python<'py>, v: &[[f64; 3]]) -> PyResult<Nodes<'py>> {
     let flat: Vec<f64> = v.iter().flatten().cloned().collect();
     let a = Array2::from_shape_vec((v.len(), 3), flat)
         .map_err(|e| shape_err("array", e.to_string()))?;
@@ -696,5 +696,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fem_stress_invariants, m)?)?;
     m.add_function(wrap_pyfunction!(fem_ball_mesh, m)?)?;
     m.add_class::<FemTetSolver>()?;
+    m.add_class::<crate::fem_shell::FemShellSolver>()?;
     Ok(())
 }

@@ -8,7 +8,7 @@ use pyo3::types::PyDict;
 use demfem::fem::contact::{
     ContactModel, ContactSettings, NoTensionSpring, RigidShape, RigidSurface,
 };
-use demfem::fem::{LinearElastic, TetMesh};
+use demfem::fem::{LinearElastic, TetMesh, TriMesh};
 use demfem::DemfemError;
 
 use crate::PyDemfemError;
@@ -113,15 +113,72 @@ pub fn build(
     let n = mesh.nodes.len();
     let body = ids(&body_of_node, "body_of_node", n)?;
     let region = ids(&region_of_node, "region_of_node", n)?;
-    let mut c = ContactModel::new(mesh, &body, &region, material, settings).map_err(err)?;
+    let c = ContactModel::new(mesh, &body, &region, material, settings).map_err(err)?;
+    extras(
+        c,
+        rigid_surfaces,
+        spring_nodes,
+        spring_anchors,
+        spring_stiffness,
+        spring_rest_length,
+    )
+}
+
+/// Build the contact model of the shell mesh `mesh` from the Python arguments (two-sided
+/// faces offset by half the thickness, penalty s·E·t).
+#[allow(clippy::too_many_arguments)]
+pub fn build_shell(
+    mesh: &TriMesh,
+    material: &LinearElastic,
+    body_of_node: PyReadonlyArray1<'_, i64>,
+    region_of_node: PyReadonlyArray1<'_, i64>,
+    settings: ContactSettings,
+    rigid_surfaces: Vec<PyRigid>,
+    spring_nodes: Option<PyReadonlyArray1<'_, i64>>,
+    spring_anchors: Option<PyReadonlyArray2<'_, f64>>,
+    spring_stiffness: Option<PyReadonlyArray1<'_, f64>>,
+    spring_rest_length: Option<PyReadonlyArray1<'_, f64>>,
+) -> PyResult<ContactModel> {
+    let n = mesh.nodes.len();
+    let body = ids(&body_of_node, "body_of_node", n)?;
+    let region = ids(&region_of_node, "region_of_node", n)?;
+    let c = ContactModel::new_shell(mesh, &body, &region, material, settings).map_err(err)?;
+    extras(
+        c,
+        rigid_surfaces,
+        spring_nodes,
+        spring_anchors,
+        spring_stiffness,
+        spring_rest_length,
+    )
+}
+
+/// Add the rigid surfaces and springs to a contact model.
+fn extras(
+    mut c: ContactModel,
+    rigid_surfaces: Vec<PyRigid>,
+    spring_nodes: Option<PyReadonlyArray1<'_, i64>>,
+    spring_anchors: Option<PyReadonlyArray2<'_, f64>>,
+    spring_stiffness: Option<PyReadonlyArray1<'_, f64>>,
+    spring_rest_length: Option<PyReadonlyArray1<'_, f64>>,
+) -> PyResult<ContactModel> {
     for r in &rigid_surfaces {
         c.add_rigid(rigid(r)?).map_err(err)?;
     }
-    match (spring_nodes, spring_anchors, spring_stiffness, spring_rest_length) {
+    match (
+        spring_nodes,
+        spring_anchors,
+        spring_stiffness,
+        spring_rest_length,
+    ) {
         (None, None, None, None) => {}
         (Some(nodes), Some(anchors), Some(k), Some(l0)) => {
-            let (nodes, anchors, k, l0) =
-                (nodes.as_array(), anchors.as_array(), k.as_array(), l0.as_array());
+            let (nodes, anchors, k, l0) = (
+                nodes.as_array(),
+                anchors.as_array(),
+                k.as_array(),
+                l0.as_array(),
+            );
             let m = nodes.len();
             if anchors.shape() != [m, 3] || k.len() != m || l0.len() != m {
                 return Err(err(DemfemError::ShapeMismatch {
@@ -148,12 +205,12 @@ pub fn build(
             }
             c.add_springs(&springs).map_err(err)?;
         }
-        _ => {
-            return Err(err(DemfemError::ShapeMismatch {
-                field: "springs".into(),
-                detail: "spring_nodes, spring_anchors, spring_stiffness and spring_rest_length go together".into(),
-            }))
-        }
+        _ => return Err(err(DemfemError::ShapeMismatch {
+            field: "springs".into(),
+            detail:
+                "spring_nodes, spring_anchors, spring_stiffness and spring_rest_length go together"
+                    .into(),
+        })),
     }
     Ok(c)
 }

@@ -14,6 +14,7 @@ mod dem_events;
 mod dem_walls;
 mod fem;
 mod fem_contact;
+mod fem_shell;
 mod rigid;
 
 /// The one conversion from core errors to Python exceptions: each variant raises the class

@@ -8,6 +8,11 @@ use crate::fem::material::LinearElastic;
 use crate::fem::mesh::TriMesh;
 use crate::fem::static_solve::solve_constrained;
 
+mod explicit_contact;
+mod explicit_state;
+
+pub use explicit_contact::ShellEnergy;
+
 /// A shell mesh with its material and precomputed elements.
 #[derive(Debug, Clone)]
 pub struct ShellModel {
@@ -146,6 +151,13 @@ pub struct ShellExplicit {
     du_prev: Vec<f64>,
     dt: f64,
     dt_limit: f64,
+    dt_requested: Option<f64>,
+    lam_max: f64,
+    dt_limit_without_contact: f64,
+    contact: Option<crate::fem::contact::ContactModel>,
+    f_contact: Vec<[f64; 3]>,
+    u3: Vec<[f64; 3]>,
+    v3: Vec<[f64; 3]>,
     steps: u64,
     /// Kinetic (½ v^{n−½}·M v^{n+½}), internal, external work and initial energy, J.
     pub energy: [f64; 4],
@@ -198,6 +210,7 @@ impl ShellExplicit {
             lam_max = lam_max.max(l);
         }
         let dt_limit = crate::fem::stable_step::critical_step_from_eigenvalue(lam_max, 0.0, 0.0)?;
+        let dt_req = dt;
         let dt = match dt {
             Some(d) => {
                 crate::error::check_positive("dt", d)?;
@@ -247,6 +260,13 @@ impl ShellExplicit {
             du_prev: vec![0.0; nd],
             dt,
             dt_limit,
+            dt_requested: dt_req,
+            lam_max,
+            dt_limit_without_contact: dt_limit,
+            contact: None,
+            f_contact: Vec::new(),
+            u3: Vec::new(),
+            v3: Vec::new(),
             steps: 0,
             energy: [0.0; 4],
         })
@@ -338,10 +358,14 @@ impl ShellExplicit {
         });
     }
 
-    /// Advance `n` steps; error on a non-finite state.
+    /// Advance `n` steps; error on a non-finite state or a contact failure (a runaway
+    /// contact, an exceeded step allowance).
     pub fn run(&mut self, n: u64) -> Result<()> {
         for _ in 0..n {
             self.step();
+            if let Some(err) = self.contact.as_mut().and_then(|c| c.take_failure()) {
+                return Err(err);
+            }
         }
         if self.u.iter().chain(&self.v).any(|x| !x.is_finite()) {
             return Err(DemfemError::Numerical("non-finite shell state".into()));
@@ -354,16 +378,19 @@ impl ShellExplicit {
         self.internal_forces();
         let first = self.steps == 0;
         let dt = self.dt;
+        let has_contact = self.contact_forces();
         let dt_n = if first { 0.5 * dt } else { dt };
         let (mut ek, mut ei, mut dw) = (0.0, 0.0, 0.0);
         for d in 0..self.u.len() {
             let m = self.mass[d];
             let v_old = self.v[d];
+            let f_ext = if has_contact && d % 6 < 3 {
+                self.loads[d] + self.f_contact[d / 6][d % 6]
+            } else {
+                self.loads[d]
+            };
             let (v_new, f_tot) = if self.free[d] {
-                (
-                    v_old + dt_n * (self.loads[d] - self.f[d]) / m,
-                    self.loads[d],
-                )
+                (v_old + dt_n * (f_ext - self.f[d]) / m, f_ext)
             } else {
                 let a = -v_old / dt_n;
                 (0.0, m * a + self.f[d])

@@ -12,6 +12,12 @@
 //! forces sum to zero (linear momentum is conserved to round-off). Against a rigid surface
 //! a node gets F = k_node d with k_node = Σ k_f/3 over its faces.
 //!
+//! **Shells.** [`ContactModel::new_shell`] builds the model on a shell mesh: every triangle
+//! is a two-sided face, its contact surfaces half its thickness from the mid-surface, and
+//! the gap of a node is its signed distance less half its own and half the face's
+//! thickness, on the side it met the face (see `narrow`); k_f = s·E·t (see
+//! `shell_surface`). Rigid surfaces meet a shell node half its thickness early.
+//!
 //! **Tangential.** An elastic stick spring of the normal stiffness with a Coulomb cap: the
 //! trial force f_t − k v_t Δt (v_t the relative tangential velocity of the node against the
 //! face or the surface material) is returned to μ f_n when it exceeds it; the dissipated
@@ -35,7 +41,9 @@
 //! `output_interval` steps.
 
 mod broad_phase;
+mod narrow;
 mod rigid;
+mod shell_surface;
 mod springs;
 mod state;
 mod surface;
@@ -52,7 +60,7 @@ use crate::error::{check_non_negative, check_positive, DemfemError, Result};
 use crate::fem::material::LinearElastic;
 use crate::fem::mesh::TetMesh;
 
-use vec3::{add, cross, dot, norm, scale, sub, tangential};
+use vec3::{add, dot, norm, scale, sub, tangential};
 
 /// Surface nodes per parallel work item (fixed, so results do not depend on the threads).
 const NODE_CHUNK: usize = 512;
@@ -150,6 +158,8 @@ struct Hit {
     penetration: f64,
     /// Depth subtracted from `penetration` in the force (see `ContactModel::offset`), m.
     offset: f64,
+    /// Side of a shell face (±1; 1 for solids and rigid surfaces).
+    side: f64,
     elastic: f64,
     dissipated: f64,
     rigid_work: f64,
@@ -193,10 +203,15 @@ pub struct ContactModel {
     // the contact stays conservative; it only shrinks (as the node comes out), and it is
     // zero except after such a switch.
     contact_face: Vec<u32>,
+    // Per surface node: the side (±1, along the face normal) of the shell face of its last
+    // contact, decided at first contact and kept (always 1 for solids).
+    side: Vec<f64>,
     last_depth: Vec<f64>,
     offset: Vec<f64>,
     x: Vec<[f64; 3]>,
     touched: Vec<usize>,
+    // Per face, this step: unit normal, area ×2 and a bounding sphere (see `narrow`).
+    face_geom: Vec<narrow::FaceGeom>,
     f_prev: Vec<[f64; 3]>,
     u_prev: Vec<[f64; 3]>,
     normal_load: Vec<f64>,
@@ -240,6 +255,18 @@ impl ContactModel {
         let nu = material.poisson_ratio;
         let bulk = material.youngs_modulus / (3.0 * (1.0 - 2.0 * nu));
         let surface = Surface::new(mesh, body_of_node, bulk, settings.penalty_scale)?;
+        Self::from_surface(surface, &mesh.nodes, body_of_node, region_of_node, settings)
+    }
+
+    /// The model on an extracted surface of a mesh with reference positions `nodes`.
+    fn from_surface(
+        surface: Surface,
+        nodes: &[[f64; 3]],
+        body_of_node: &[u32],
+        region_of_node: &[u32],
+        settings: ContactSettings,
+    ) -> Result<Self> {
+        let n = nodes.len();
         let n_bodies = body_of_node
             .iter()
             .map(|&b| b as usize + 1)
@@ -264,7 +291,7 @@ impl ContactModel {
         Ok(Self {
             settings,
             broad: BroadPhase::new(margin),
-            reference: mesh.nodes.clone(),
+            reference: nodes.to_vec(),
             n_bodies,
             region: region_of_node.to_vec(),
             n_regions,
@@ -275,10 +302,12 @@ impl ContactModel {
             last_face: vec![u32::MAX; ns],
             last_contact: vec![u64::MAX; ns],
             contact_face: vec![u32::MAX; ns],
+            side: vec![1.0; ns],
             last_depth: vec![0.0; ns],
             offset: vec![0.0; ns],
             x: vec![[0.0; 3]; n],
             touched: surface.nodes.clone(),
+            face_geom: Vec::new(),
             f_prev: vec![[0.0; 3]; n],
             u_prev: vec![[0.0; 3]; n],
             normal_load: vec![0.0; ns],
@@ -424,6 +453,13 @@ impl ContactModel {
             spring_row[s.node] += s.stiffness / mass[s.node];
         }
         let spring_term = spring_row.iter().fold(0.0f64, |a, &b| a.max(b));
+        // A shell node is a slave and, at a ridge met head-on, the corner its own faces give
+        // weight 1 to another body's slave: two full-stiffness springs per node.
+        let face_term = if self.is_shell() {
+            2.0 * face_term
+        } else {
+            face_term
+        };
         let allowance = self.settings.contacts_per_node * face_term + rigid_term + spring_term;
         if !allowance.is_finite() {
             return Err(DemfemError::Numerical(
@@ -438,11 +474,12 @@ impl ContactModel {
     /// Error for bodies that overlap at the start by more than the tolerance.
     pub fn check_initial_overlap(&mut self, u: &[[f64; 3]]) -> Result<()> {
         self.update_positions(u);
+        self.update_face_geometry();
         self.broad.rebuild(&self.surface, &self.x, u);
         let tol = self.settings.initial_overlap_tolerance;
         for k in 0..self.surface.nodes.len() {
             // At the start the whole element's height counts, to catch overlaps.
-            if let Some((f, d, _)) = self.closest_face(k, 1.0) {
+            if let Some((f, d, _, _, _)) = self.closest_face(k, 1.0) {
                 if d > tol {
                     let face = &self.surface.faces[f];
                     return Err(DemfemError::InvalidParameter {
@@ -457,7 +494,8 @@ impl ContactModel {
             }
             let i = self.surface.nodes[k];
             for (r, s) in self.rigid.iter().enumerate() {
-                if let Some((d, _, _)) = s.probe(self.x[i], 0.0) {
+                let hn = self.surface.node_half_thickness[k];
+                if let Some((d, _, _)) = s.probe_offset(self.x[i], 0.0, hn) {
                     if d > tol {
                         return Err(DemfemError::InvalidParameter {
                             field: "initial positions".into(),
@@ -480,55 +518,12 @@ impl ContactModel {
         }
     }
 
-    /// Unit normal of `face` now and the velocity (m/s) of its point with barycentric
-    /// weights `w`.
-    fn face_normal_and_velocity(
-        &self,
-        face: &SurfaceFace,
-        w: [f64; 3],
-        v: &[[f64; 3]],
-    ) -> ([f64; 3], [f64; 3]) {
-        let [a, b, c] = face.nodes.map(|j| self.x[j]);
-        let nrm = cross(sub(b, a), sub(c, a));
-        let vf = add(
+    /// The velocity (m/s) of the point of `face` with barycentric weights `w`.
+    fn face_velocity(&self, face: &SurfaceFace, w: [f64; 3], v: &[[f64; 3]]) -> [f64; 3] {
+        add(
             add(scale(v[face.nodes[0]], w[0]), scale(v[face.nodes[1]], w[1])),
             scale(v[face.nodes[2]], w[2]),
-        );
-        (scale(nrm, 1.0 / norm(nrm)), vf)
-    }
-
-    /// The face the surface node `k` is behind (face index, penetration, weights).
-    fn closest_face(&self, k: usize, depth_fraction: f64) -> Option<(usize, f64, [f64; 3])> {
-        let p = self.x[self.surface.nodes[k]];
-        let mut best: Option<(usize, f64, [f64; 3])> = None;
-        for &f in self.broad.faces_of(k) {
-            let face = &self.surface.faces[f as usize];
-            let [a, b, c] = face.nodes.map(|i| self.x[i]);
-            let nrm = cross(sub(b, a), sub(c, a));
-            let area2 = norm(nrm);
-            if !(area2 > 0.0) {
-                continue;
-            }
-            let n = scale(nrm, 1.0 / area2);
-            let g = dot(sub(p, a), n);
-            // Half the element's height: a node deeper than that is nearer another face of
-            // the body (or on the far side of a thin wall), not on this one.
-            if !(g < 0.0) || -g > depth_fraction * face.depth {
-                continue;
-            }
-            let q = sub(p, scale(n, g));
-            let w0 = dot(cross(sub(b, q), sub(c, q)), n) / area2;
-            let w1 = dot(cross(sub(c, q), sub(a, q)), n) / area2;
-            let w2 = 1.0 - w0 - w1;
-            const EPS: f64 = -1e-9;
-            if w0 < EPS || w1 < EPS || w2 < EPS {
-                continue;
-            }
-            if best.is_none_or(|(_, d, _)| -g < d) {
-                best = Some((f as usize, -g, [w0, w1, w2]));
-            }
-        }
-        best
+        )
     }
 
     /// Contact and spring forces (N, added into `force`, one per node) at displacement `u`
@@ -543,6 +538,7 @@ impl ContactModel {
         force: &mut [[f64; 3]],
     ) {
         self.update_positions(u);
+        self.update_face_geometry();
         if self.broad.needs_rebuild(&self.surface, u) {
             self.broad.rebuild(&self.surface, &self.x, u);
         }
@@ -562,9 +558,9 @@ impl ContactModel {
                     let mut out = Vec::new();
                     for k in k0..k1 {
                         let i = this.surface.nodes[k];
-                        if let Some((f, d, w)) = this.closest_face(k, 0.5) {
+                        if let Some((f, d, w, side, n)) = this.closest_face(k, 0.5) {
                             let face = &this.surface.faces[f];
-                            let (n, vf) = this.face_normal_and_velocity(face, w, v);
+                            let vf = this.face_velocity(face, w, v);
                             let vrel = sub(v[i], vf);
                             // A node in contact within the last few steps may come back at
                             // any depth the face takes (it lost the face for a step at an
@@ -606,6 +602,7 @@ impl ContactModel {
                                     stiffness: face.stiffness,
                                     penetration: d,
                                     offset,
+                                    side,
                                     elastic: h.2,
                                     dissipated: h.3,
                                     rigid_work: 0.0,
@@ -613,7 +610,8 @@ impl ContactModel {
                             }
                         }
                         for (r, s) in this.rigid.iter().enumerate() {
-                            if let Some((d, n, vs)) = s.probe(this.x[i], t) {
+                            let hn = this.surface.node_half_thickness[k];
+                            if let Some((d, n, vs)) = s.probe_offset(this.x[i], t, hn) {
                                 let kn = this.surface.node_stiffness[k];
                                 let vrel = sub(v[i], vs);
                                 let h = friction_update(
@@ -637,6 +635,7 @@ impl ContactModel {
                                     stiffness: kn,
                                     penetration: d,
                                     offset: 0.0,
+                                    side: 1.0,
                                     elastic: h.2,
                                     dissipated: h.3,
                                     rigid_work: work,
@@ -695,6 +694,7 @@ impl ContactModel {
                 new_last[k] = h.partner;
                 self.last_contact[k] = self.steps;
                 self.contact_face[k] = h.partner;
+                self.side[k] = h.side;
                 self.last_depth[k] = h.penetration - h.offset;
                 self.offset[k] = h.offset;
                 for (j, &node) in face.nodes.iter().enumerate() {
@@ -748,26 +748,7 @@ impl ContactModel {
                 chan[c].max_penetration = chan[c].max_penetration.max(h.penetration);
             }
         }
-        // A node that was on a face and is now deeper than the element under it ran away.
-        if self.failure.is_none() {
-            for k in 0..ns {
-                let f = self.last_face[k];
-                if f != u32::MAX && new_last[k] == u32::MAX {
-                    let face = self.surface.faces[f as usize];
-                    let p = self.x[self.surface.nodes[k]];
-                    let [a, b, c] = face.nodes.map(|j| self.x[j]);
-                    let nrm = cross(sub(b, a), sub(c, a));
-                    let g = dot(sub(p, a), nrm) / norm(nrm);
-                    if -g > 0.5 * face.depth {
-                        self.failure = Some(DemfemError::Numerical(format!(
-                            "contact ran away at t = {t:e} s: node {} of body {} is {:e} m behind a face of body {} (the element under it is {:e} m deep); lower the step or raise the penalty scale",
-                            self.surface.nodes[k], self.surface.node_body[k], -g, face.body, face.depth
-                        )));
-                        break;
-                    }
-                }
-            }
-        }
+        self.check_runaway(&new_last, t);
         self.last_face = new_last;
         // No-tension springs.
         let mut spring_energy = 0.0;

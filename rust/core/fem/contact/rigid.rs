@@ -121,15 +121,22 @@ impl RigidSurface {
     /// Penetration d > 0, outward unit normal and surface velocity at `p` at time `t`, or
     /// `None` when `p` is outside the solid.
     pub fn probe(&self, p: [f64; 3], t: f64) -> Option<(f64, [f64; 3], [f64; 3])> {
+        self.probe_offset(p, t, 0.0)
+    }
+
+    /// As [`Self::probe`] for a point whose contact surface lies `h` (m, ≥ 0) from it
+    /// towards the solid (a shell node of half thickness h): penetration d + h when that is
+    /// positive.
+    pub fn probe_offset(&self, p: [f64; 3], t: f64, h: f64) -> Option<(f64, [f64; 3], [f64; 3])> {
         match self.shape {
             RigidShape::Plane { point, normal } => {
                 let g = dot(sub(p, point), normal);
-                if g < 0.0 {
+                if g < h {
                     let vs = sub(
                         self.surface_velocity,
                         scale(normal, dot(self.surface_velocity, normal)),
                     );
-                    Some((-g, normal, vs))
+                    Some((h - g, normal, vs))
                 } else {
                     None
                 }
@@ -146,8 +153,8 @@ impl RigidSurface {
                 ];
                 let r = sub(p, c);
                 let l = norm(r);
-                if l < radius && l > 0.0 {
-                    Some((radius - l, scale(r, 1.0 / l), velocity))
+                if l < radius + h && l > 0.0 {
+                    Some((radius + h - l, scale(r, 1.0 / l), velocity))
                 } else {
                     None
                 }
@@ -160,8 +167,12 @@ impl RigidSurface {
                 let r = sub(p, point);
                 let radial = sub(r, scale(axis, dot(r, axis)));
                 let l = norm(radial);
-                if l < radius && l > 0.0 {
-                    Some((radius - l, scale(radial, 1.0 / l), self.surface_velocity))
+                if l < radius + h && l > 0.0 {
+                    Some((
+                        radius + h - l,
+                        scale(radial, 1.0 / l),
+                        self.surface_velocity,
+                    ))
                 } else {
                     None
                 }

@@ -17,6 +17,9 @@ impl ContactModel {
         w.u32s("contact.contact_face", &self.contact_face);
         w.f64s("contact.last_depth", &self.last_depth);
         w.f64s("contact.offset", &self.offset);
+        if self.is_shell() {
+            w.f64s("contact.side", &self.side);
+        }
         w.vec3s("contact.x", &self.x);
         w.vec3s("contact.f_prev", &self.f_prev);
         w.vec3s("contact.u_prev", &self.u_prev);
@@ -67,6 +70,11 @@ impl ContactModel {
         let contact_face = r.u32s("contact.contact_face", Some(ns))?;
         let last_depth = r.f64s("contact.last_depth", Some(ns))?;
         let offset = r.f64s("contact.offset", Some(ns))?;
+        let side = if self.is_shell() {
+            Some(r.f64s("contact.side", Some(ns))?)
+        } else {
+            None
+        };
         let x = r.vec3s("contact.x", Some(n))?;
         let f_prev = r.vec3s("contact.f_prev", Some(n))?;
         let u_prev = r.vec3s("contact.u_prev", Some(n))?;
@@ -103,6 +111,9 @@ impl ContactModel {
         self.contact_face = contact_face;
         self.last_depth = last_depth;
         self.offset = offset;
+        if let Some(side) = side {
+            self.side = side;
+        }
         self.x = x;
         self.f_prev = f_prev;
         self.u_prev = u_prev;

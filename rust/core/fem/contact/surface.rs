@@ -31,6 +31,9 @@ pub struct SurfaceFace {
     pub depth: f64,
     /// Area in the reference configuration, m².
     pub area: f64,
+    /// Half the shell thickness for a shell face (two-sided, its contact surfaces offset
+    /// by this from the mid-surface on both sides), 0 for the one-sided face of a solid, m.
+    pub half_thickness: f64,
 }
 
 /// The boundary of a mesh made of several bodies.
@@ -48,6 +51,9 @@ pub struct Surface {
     pub node_area: Vec<f64>,
     /// Penalty stiffness of each surface node, N/m.
     pub node_stiffness: Vec<f64>,
+    /// Half the shell thickness at each surface node (0 for solids), m: a shell node's
+    /// contact surfaces lie this far from it on both sides.
+    pub node_half_thickness: Vec<f64>,
     /// Largest face diameter (longest edge) in the reference configuration, m.
     pub max_face_size: f64,
     /// Mean face edge length, m.
@@ -138,6 +144,7 @@ impl Surface {
                 stiffness: penalty_scale * bulk_modulus * area * area / vol,
                 depth: 3.0 * vol / area,
                 area,
+                half_thickness: 0.0,
             });
         }
         let mut slot = vec![u32::MAX; n];
@@ -162,6 +169,7 @@ impl Surface {
             edge_sum / (3.0 * faces.len() as f64)
         };
         let node_body = nodes.iter().map(|&i| body_of_node[i]).collect();
+        let node_half_thickness = vec![0.0; nodes.len()];
         Ok(Self {
             faces,
             nodes,
@@ -169,6 +177,7 @@ impl Surface {
             node_body,
             node_area,
             node_stiffness,
+            node_half_thickness,
             max_face_size,
             mean_edge,
         })
