@@ -194,6 +194,11 @@ def test_tiny_run_writes_every_output(tmp_path):
     assert summary["steps"] > 0 and summary["force_peaks"]["1-2_bottom"]["normal_N"] > 0
     header = (out / "forces.csv").read_text().splitlines()[0]
     assert header.startswith("time_s,fn_12_bottom_N,fn_12_top_N,ft_12_bottom_N")
+    # the through-wall line runs from the local inner to the outer surface, also where the
+    # contact sits on the shoulder (the element centroids lie strictly inside the wall)
+    for pair in ("1-2", "1-3"):
+        depth = summary["through_wall"][pair]["depth_fraction"]
+        assert 0.0 < min(depth) and max(depth) < 1.0, (pair, depth)
     # a rerun reuses the FEM run; other settings are refused
     (out / "cluster_sigma1.png").unlink()
     s2 = run_cluster(c, duration=3e-4, out=out, progress=False, n_snapshots=4)

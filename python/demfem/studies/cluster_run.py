@@ -431,7 +431,6 @@ def _write_outputs(cluster: CartridgeCluster, data: dict, out: Path, log: Log) -
 
     # Fig. 12b,d: through the wall at each pair's peak
     c = cluster.cartridge
-    ri = 0.5 * c.body_outer_diameter - c.wall_thickness
     through: dict[str, dict] = {}
     fig, ax = plt.subplots(figsize=(6, 4.5))
     for p in PAIRS:
@@ -445,7 +444,9 @@ def _write_outputs(cluster: CartridgeCluster, data: dict, out: Path, log: Log) -
                                               0.6 * cluster.element_size())
         sel = np.flatnonzero(line)
         order = np.argsort(geo["r"][sel])
-        depth = (geo["r"][sel][order] - ri) / c.wall_thickness
+        # through the local wall (the top contact may sit on the shoulder, not the body)
+        ri, ro = c.radii_at(np.clip(geo["z"][sel][order], 0.0, c.length))
+        depth = (geo["r"][sel][order] - ri) / (ro - ri)
         vals = sig[k, sel][order]
         ax.plot(depth, vals / 1e6, "o-", label=f"1-{p} {REGIONS[r][1]}, t = {ts[k] * 1e3:.3g} ms")
         through[f"1-{p}"] = {"region": REGIONS[r][1], "time_s": float(ts[k]),
