@@ -239,6 +239,17 @@ def test_outputs_and_report(small_job):
     assert all(float(r["normal_speed_m_per_s"]) >= 5e-3 or float(r["force_N"]) >= 0.26
                for r in rows)
     assert doc["summary"]["forces_measured"] and doc["events"]["measured"]
+    # ParaView: the window's likeliest events at their contact points, every cartridge at its
+    # last position with its risk
+    import xml.etree.ElementTree as ET
+
+    in_window = sum(r["in_window"] == "1" for r in rows)
+    for name, count, field in (("events.vtp", min(in_window, 20_000), "p_event"),
+                               ("cartridges.vtp", SMALL.n_spheres, "p_passage")):
+        piece = ET.parse(out / name).getroot().find("PolyData/Piece")
+        assert int(piece.get("NumberOfPoints")) == count, name
+        names = [a.get("Name") for a in piece.find("PointData")]
+        assert field in names, (name, names)
     walls = [r for r in rows if r["partner"] == "wall"]
     assert walls and all(r["j"] == "-1" and int(r["wall"]) > 0 for r in walls)  # never the belt
     assert doc["events"]["n_wall_events"] == len(walls)

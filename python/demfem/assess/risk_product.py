@@ -12,7 +12,46 @@ import numpy as np
 from demfem.assess.risk_stage import (cartridge_risk, event_hazard, event_probabilities,
                                       risk_map, steady_state, worst_events)
 
-__all__ = ["risk_document"]
+__all__ = ["risk_document", "VTK_EVENTS"]
+
+#: Most events written to ``events.vtp`` (the window's likeliest to break a cartridge; ASCII
+#: VTK of all ~10^6 events of a run would be ~200 MB).
+VTK_EVENTS = 20_000
+
+
+def _write_vtk(out: Path, run, events: np.ndarray, p: dict[str, np.ndarray],
+               stress: dict[str, np.ndarray], cr: dict[str, Any],
+               inside: np.ndarray) -> list[Path]:
+    """``events.vtp``: the window's :data:`VTK_EVENTS` events with the largest P_k at their
+    contact points (m), with P_k, force (N), σ1 inner and outer (Pa), time (s), partner
+    (0 cartridge, 1 wall) and the cartridge; ``cartridges.vtp``: every cartridge at its last
+    position on the table (m) with its P per passage, P over the window, events and hazard
+    rate (1/s). For ParaView (Glyph or Point Gaussian)."""
+    from demfem.io.vtk import write_vtp
+
+    idx = np.flatnonzero(inside)
+    idx = idx[np.argsort(-p["p_event"][idx], kind="stable")][:VTK_EVENTS]
+    pts = np.column_stack([events["x"][idx], events["y"][idx], events["z"][idx]])
+    ok = np.all(np.isfinite(pts), axis=1)
+    idx, pts = idx[ok], pts[ok]
+    files = [write_vtp(out / "events.vtp", pts, {
+        "p_event": p["p_event"][idx], "force_N": stress["force_N"][idx],
+        "sigma_inner_Pa": stress["sigma_inner_Pa"][idx],
+        "sigma_outer_Pa": stress["sigma_outer_Pa"][idx], "time_s": events["time"][idx],
+        "partner": events["partner"][idx].astype(np.int64),
+        "cartridge": events["i"][idx].astype(np.int64)})]
+    pos = np.asarray(run.positions, float)
+    finite = np.all(np.isfinite(pos), axis=2)
+    last = np.where(finite.any(axis=0), pos.shape[0] - 1 - np.argmax(finite[::-1], axis=0), -1)
+    seen = last >= 0
+    where = pos[last[seen], np.flatnonzero(seen)]
+    files.append(write_vtp(out / "cartridges.vtp", where, {
+        "cartridge": np.flatnonzero(seen).astype(np.int64),
+        "radius": np.asarray(run.radii, float)[seen],
+        "p_passage": cr["p_passage"][seen], "p_window": cr["p_window"][seen],
+        "n_events": np.asarray(cr["n_events"], np.int64)[seen],
+        "hazard_per_s": cr["hazard_per_s"][seen]}))
+    return files
 
 
 def _basis(model, scg, ev_summary: dict[str, Any], e_stress: float, table,
@@ -185,6 +224,7 @@ def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[st
                     f"{cr['p_window'][i]:.6g},{cr['hazard_per_s'][i]:.6g},"
                     f"{cr['p_passage'][i]:.6g}")
     files.append(write_text_atomic(out / "cartridges.csv", "\n".join(rows) + "\n"))
+    files += _write_vtk(out, run, events, p, stress, cr, inside)
     files.append(_save_npz(out / "risk_arrays.npz", p_passage=cr["p_passage"],
                            p_window=cr["p_window"], p_event=p["p_event"],
                            **{f"map_{k}": v for k, v in rmap.items()}))

@@ -58,7 +58,8 @@ def steady_rule(table, full: bool = False, min_speed: float = DEFAULT_MIN_SPEED)
 
 #: Files the job writes (removed by a fresh start), besides the DEM checkpoint.
 OUTPUT_FILES = ("calibration.json", "table_run.npz", "events.npz", "stress.npz", "risk.json",
-                "events.csv", "cartridges.csv", "risk_arrays.npz", "report.html")
+                "events.csv", "cartridges.csv", "events.vtp", "cartridges.vtp",
+                "risk_arrays.npz", "report.html")
 
 
 def _save_npz(path: Path, **arrays: Any) -> Path:
@@ -354,6 +355,7 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
                                       render_report(risk, figs, figures_names))
         book.complete("report", [html_path, *(out / n for n in figs)])
     log(f"  written to {out}: report.html, risk.json, events.csv, cartridges.csv, "
+        "events.vtp, cartridges.vtp (ParaView), "
         + ", ".join(figures_names))
     return risk
 
