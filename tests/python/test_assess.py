@@ -418,3 +418,17 @@ def test_setups_ranked_by_risk_through_demfem_sweep(tmp_path, capsys):
     assert main([*base, "--grid", "belt_velocity=0.1", "--rank-by", "nope",
                  "--out", str(tmp_path / "a")]) == 2
     assert "nope" in capsys.readouterr().err
+
+
+def test_a_reduced_modulus_is_flagged_with_its_measured_effect(tmp_path):
+    """A DEM at 1e8 Pa: the report warns and cites the measured effect of the softer table,
+    and the stresses use the law at the glass's modulus when asked (the DEM's measured forces
+    hold at its own modulus only)."""
+    soft = dataclasses.replace(SMALL, young_modulus=1e8)
+    lines = []
+    risk = assess(soft, out=tmp_path, duration=0.05, sample_interval=0.01,
+                  stress_young_modulus=45e9, log=lines.append)
+    text = " ".join(risk["warnings"])
+    assert "reduced Young's modulus" in text and "Spearman 0.92" in text
+    assert not risk["summary"]["forces_measured"]
+    assert any("calibrated law at the onset speed" in line for line in lines)
