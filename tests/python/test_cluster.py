@@ -263,6 +263,18 @@ def test_shell_cluster_geometry_and_tiny_run(tmp_path):
     assert s["force_peaks"]["1-2_bottom"]["normal_N"] > 0
     assert s["through_wall"]["1-2"]["depth_fraction"][0] == pytest.approx(0.0)
     assert s["through_wall"]["1-2"]["depth_fraction"][-1] == pytest.approx(1.0)
+    # the VTK series for ParaView: the mid-surface triangles with σ1 on both faces
+    import xml.etree.ElementTree as ET
+
+    assert (out / "cluster.pvd").exists() and (out / "vtk" / "cluster_0003.vtu").exists()
+    piece = ET.parse(out / "vtk" / "cluster_0003.vtu").getroot().find("UnstructuredGrid/Piece")
+    assert int(piece.get("NumberOfCells")) == sum(len(m.triangles) for m in p.meshes)
+    cells = [a.get("Name") for a in piece.find("CellData")]
+    assert {"sigma1_bottom", "sigma1_top", "thickness"} <= set(cells)
+    assert [a.get("Name") for a in piece.find("PointData")] == ["displacement",
+                                                                 "contact_pressure"]
+    top = piece.find("CellData/DataArray[@Name='sigma1_top']").text.split()
+    assert len(top) == int(piece.get("NumberOfCells")) and max(map(float, top)) > 0
 
 
 def test_shell_energy_balance_through_the_impacts_with_springs():

@@ -74,3 +74,32 @@ def test_animation_gif(tmp_path, scene):
     with Image.open(path) as image:
         assert image.format == "GIF" and image.n_frames == 3
     assert [p.name for p in tmp_path.iterdir()] == ["movie.gif"]
+
+
+def test_triangle_meshes_are_written_as_vtu_and_bad_ones_refused(tmp_path):
+    """`write_vtu_triangles` (the shells' VTK): points, triangles, point and cell data round
+    trip through the XML; wrong shapes and out-of-range nodes are refused naming the field."""
+    import xml.etree.ElementTree as ET
+
+    import numpy as np
+    import pytest
+
+    from demfem.errors import InvalidParameterError, ShapeError
+    from demfem.io.vtk import write_vtu_triangles
+
+    pts = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]])
+    tri = np.array([[0, 1, 2], [1, 3, 2]])
+    path = write_vtu_triangles(tmp_path / "t.vtu", pts, tri, {"u": np.ones((4, 3))},
+                               {"s": np.array([1.5, -2.0])})
+    piece = ET.parse(path).getroot().find("UnstructuredGrid/Piece")
+    assert (piece.get("NumberOfPoints"), piece.get("NumberOfCells")) == ("4", "2")
+    assert piece.find("Cells/DataArray[@Name='types']").text.split() == ["5", "5"]
+    assert piece.find("Cells/DataArray[@Name='connectivity']").text.split() == \
+        ["0", "1", "2", "1", "3", "2"]
+    assert [float(x) for x in piece.find("CellData/DataArray").text.split()] == [1.5, -2.0]
+    with pytest.raises(InvalidParameterError, match="triangles"):
+        write_vtu_triangles(tmp_path / "b.vtu", pts, np.array([[0, 1, 7]]))
+    with pytest.raises(ShapeError, match="cell_data"):
+        write_vtu_triangles(tmp_path / "b.vtu", pts, tri, cell_data={"s": np.ones(3)})
+    with pytest.raises(ShapeError, match="points"):
+        write_vtu_triangles(tmp_path / "b.vtu", pts[:, :2], tri)

@@ -398,8 +398,20 @@ class FemModel:
                         contact_pressure=np.asarray(self._solver.contact_pressure()))
 
     def write_vtu(self, path: Union[str, Path]) -> None:
-        """Write the current state (displacement, velocity, stresses, σ1, contact pressure)
-        to a VTK .vtu file (tet bodies only)."""
+        """Write the current state to a VTK .vtu file: for tets displacement, velocity,
+        stresses, σ1 and contact pressure; for shells the mid-surface triangles with the
+        nodes' displacement (m) and contact pressure (Pa), and per triangle σ1 on its bottom
+        (−t/2 along its normal), middle and top (+t/2) surfaces (Pa) and its thickness (m)."""
         if self.elements == "shell":
-            raise InvalidParameterError("invalid write_vtu: not available for shell bodies yet")
+            from demfem.io.vtk import write_vtu_triangles
+
+            snap = self.snapshot()
+            s = np.asarray(snap.sigma1_surfaces)
+            mesh = self.mesh
+            assert isinstance(mesh, ShellMesh)
+            write_vtu_triangles(path, mesh.nodes, mesh.triangles, point_data={
+                "displacement": snap.displacement, "contact_pressure": snap.contact_pressure},
+                cell_data={"sigma1_bottom": s[:, 0], "sigma1_middle": s[:, 1],
+                           "sigma1_top": s[:, 2], "thickness": mesh.thickness})
+            return
         self._solver.write_vtu(Path(path))

@@ -17,7 +17,7 @@ import numpy as np
 from demfem.errors import InvalidParameterError, ShapeError
 from demfem.io.atomic import write_text_atomic
 
-__all__ = ["write_vtp", "write_pvd", "write_vtk_series"]
+__all__ = ["write_vtp", "write_pvd", "write_vtk_series", "write_vtu_triangles"]
 
 
 def _vtk_type(values: np.ndarray, name: str) -> tuple[str, np.ndarray]:
@@ -90,6 +90,65 @@ def write_vtp(path: str | Path, positions: np.ndarray,
         _data_array("Int64", index + 1, "offsets", 1),
         "</Verts>",
         "</Piece>", "</PolyData>", "</VTKFile>", "",
+    ])
+    return write_text_atomic(path, text)
+
+
+def _arrays(data: Mapping[str, np.ndarray] | None, n: int, what: str) -> list[str]:
+    out = []
+    for name, values in (data or {}).items():
+        if not isinstance(name, str) or not name:
+            raise InvalidParameterError(f"invalid {what} name = {name!r}: must be a non-empty "
+                                        "string")
+        values = np.asarray(values)
+        if values.ndim not in (1, 2) or values.shape[0] != n:
+            raise ShapeError(f"shape mismatch for {what}[{name!r}]: expected ({n},) or "
+                             f"({n}, k), got {values.shape}")
+        vtk_type, values = _vtk_type(values, name)
+        out.append(_data_array(vtk_type, values, name, 1 if values.ndim == 1 else values.shape[1]))
+    return out
+
+
+def write_vtu_triangles(path: str | Path, points: np.ndarray, triangles: np.ndarray,
+                        point_data: Mapping[str, np.ndarray] | None = None,
+                        cell_data: Mapping[str, np.ndarray] | None = None) -> Path:
+    """Write a triangle mesh (a shell's mid-surface) as a VTK UnstructuredGrid (``.vtu``,
+    ASCII, atomically); returns the path.
+
+    Args:
+        path: output file, conventionally ``*.vtu``.
+        points: (N, 3) node coordinates, m, finite.
+        triangles: (T, 3) node indices (0-based).
+        point_data: name -> (N,) or (N, k) per node (e.g. ``displacement`` (N, 3) in m).
+        cell_data: name -> (T,) or (T, k) per triangle (e.g. ``sigma1_top`` in Pa).
+    """
+    pts = np.asarray(points, float)
+    tri = np.asarray(triangles)
+    if pts.ndim != 2 or pts.shape[1] != 3:
+        raise ShapeError(f"shape mismatch for points: expected (N, 3), got {pts.shape}")
+    if tri.ndim != 2 or tri.shape[1] != 3 or not np.issubdtype(tri.dtype, np.integer):
+        raise ShapeError(f"shape mismatch for triangles: expected (T, 3) integers, got "
+                         f"{tri.shape} {tri.dtype}")
+    if not np.all(np.isfinite(pts)):
+        raise InvalidParameterError("invalid points: must be finite")
+    n, t = len(pts), len(tri)
+    if t and (tri.min() < 0 or tri.max() >= n):
+        raise InvalidParameterError(f"invalid triangles: node indices must be in [0, {n})")
+    text = "\n".join([
+        '<?xml version="1.0"?>',
+        '<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian" '
+        'header_type="UInt64">',
+        "<UnstructuredGrid>",
+        f'<Piece NumberOfPoints="{n}" NumberOfCells="{t}">',
+        "<PointData>", *_arrays(point_data, n, "point_data"), "</PointData>",
+        "<CellData>", *_arrays(cell_data, t, "cell_data"), "</CellData>",
+        "<Points>", _data_array("Float64", pts, None, 3), "</Points>",
+        "<Cells>",
+        _data_array("Int64", tri.astype(np.int64), "connectivity", 1),
+        _data_array("Int64", 3 * np.arange(1, t + 1, dtype=np.int64), "offsets", 1),
+        _data_array("UInt8", np.full(t, 5, np.uint8), "types", 1),  # VTK_TRIANGLE
+        "</Cells>",
+        "</Piece>", "</UnstructuredGrid>", "</VTKFile>", "",
     ])
     return write_text_atomic(path, text)
 

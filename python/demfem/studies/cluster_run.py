@@ -187,7 +187,7 @@ def _simulate(cluster: CartridgeCluster, duration: float, n_snapshots: int, out:
     e1 = model.body_elements(0)
     n1 = model.body_nodes(0)
     shell = cluster.elements == "shell"
-    kind = ("shell triangles (σ1 on the inner and outer faces, no VTK files" if shell else
+    kind = ("shell triangles (σ1 on the inner and outer faces" if shell else
             f"tets ({cluster.layers} through the wall")
     log(f"cluster: {model.mesh.n_elements} {kind}, "
         f"n_theta = {parts.n_theta}), dt = {model.dt_step:.3g} s, about "
@@ -238,7 +238,7 @@ def _simulate(cluster: CartridgeCluster, duration: float, n_snapshots: int, out:
             snaps_t.append(model.time)
             sig.append(s1.astype(np.float32))
             press.append(np.asarray(model.solver.contact_pressure())[n1].astype(np.float32))
-            if t_target in vtk_set and not shell:
+            if t_target in vtk_set:
                 name = f"cluster_{len(frames):04d}.vtu"
                 model.write_vtu(vtk / name)
                 frames.append((model.time, f"vtk/{name}"))
