@@ -50,8 +50,6 @@ impl Surface {
         }
         let t_max = mesh.thickness.iter().cloned().fold(0.0f64, f64::max);
         let mut faces = Vec::with_capacity(mesh.triangles.len());
-        let mut max_face_size: f64 = 0.0;
-        let mut edge_sum = 0.0;
         for (e, (tri, &t)) in mesh.triangles.iter().zip(&mesh.thickness).enumerate() {
             let b = body_of_node[tri[0]];
             if tri.iter().any(|&i| body_of_node[i] != b) {
@@ -62,9 +60,6 @@ impl Surface {
             }
             let [a, bb, c] = tri.map(|i| mesh.nodes[i]);
             let area = 0.5 * norm(cross(sub(bb, a), sub(c, a)));
-            let edges = [norm(sub(bb, a)), norm(sub(c, bb)), norm(sub(a, c))];
-            max_face_size = max_face_size.max(edges[0].max(edges[1]).max(edges[2]));
-            edge_sum += edges[0] + edges[1] + edges[2];
             faces.push(SurfaceFace {
                 nodes: *tri,
                 element: e,
@@ -77,44 +72,7 @@ impl Surface {
                 half_thickness: 0.5 * t,
             });
         }
-        let mut slot = vec![u32::MAX; n];
-        let mut nodes: Vec<usize> = faces.iter().flat_map(|f| f.nodes).collect();
-        nodes.sort_unstable();
-        nodes.dedup();
-        for (k, &i) in nodes.iter().enumerate() {
-            slot[i] = k as u32;
-        }
-        let mut node_area = vec![0.0; nodes.len()];
-        let mut node_stiffness = vec![0.0; nodes.len()];
-        let mut node_half_thickness = vec![0.0; nodes.len()];
-        for f in &faces {
-            for &i in &f.nodes {
-                let s = slot[i] as usize;
-                node_area[s] += f.area / 3.0;
-                node_stiffness[s] += f.stiffness / 3.0;
-                node_half_thickness[s] += f.half_thickness * f.area / 3.0;
-            }
-        }
-        for (h, a) in node_half_thickness.iter_mut().zip(&node_area) {
-            *h /= a;
-        }
-        let mean_edge = if faces.is_empty() {
-            0.0
-        } else {
-            edge_sum / (3.0 * faces.len() as f64)
-        };
-        let node_body = nodes.iter().map(|&i| body_of_node[i]).collect();
-        Ok(Self {
-            faces,
-            nodes,
-            slot,
-            node_body,
-            node_area,
-            node_stiffness,
-            node_half_thickness,
-            max_face_size,
-            mean_edge,
-        })
+        Ok(Self::from_faces(faces, &mesh.nodes, body_of_node))
     }
 }
 

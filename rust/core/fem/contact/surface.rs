@@ -111,8 +111,6 @@ impl Surface {
             .collect();
         boundary.sort_unstable();
         let mut faces = Vec::with_capacity(boundary.len());
-        let mut max_face_size: f64 = 0.0;
-        let mut edge_sum = 0.0;
         for (e, lf) in boundary {
             let t = mesh.tets[e];
             let (f, opp) = LOCAL_FACES[lf];
@@ -123,7 +121,6 @@ impl Surface {
                 nodes.swap(1, 2);
             }
             let area = 0.5 * norm(nrm);
-            let [a, b, c] = [x(nodes[0]), x(nodes[1]), x(nodes[2])];
             let vol = (dot(
                 sub(x(t[1]), x(t[0])),
                 cross(sub(x(t[2]), x(t[0])), sub(x(t[3]), x(t[0]))),
@@ -134,9 +131,6 @@ impl Surface {
                     "element {e}: degenerate boundary face (area {area:e} m², volume {vol:e} m³)"
                 )));
             }
-            let edges = [norm(sub(b, a)), norm(sub(c, b)), norm(sub(a, c))];
-            max_face_size = max_face_size.max(edges[0].max(edges[1]).max(edges[2]));
-            edge_sum += edges[0] + edges[1] + edges[2];
             faces.push(SurfaceFace {
                 nodes,
                 element: e,
@@ -147,7 +141,27 @@ impl Surface {
                 half_thickness: 0.0,
             });
         }
-        let mut slot = vec![u32::MAX; n];
+        Ok(Self::from_faces(faces, &mesh.nodes, body_of_node))
+    }
+
+    /// The surface of `faces` over the nodes `x` (m): the surface nodes (those of the faces,
+    /// in increasing order) with their tributary areas A/3, stiffnesses k_f/3 and
+    /// area-weighted half thicknesses, the largest and the mean face edge. Shared by the
+    /// tetrahedral and the shell surfaces.
+    pub(super) fn from_faces(
+        faces: Vec<SurfaceFace>,
+        x: &[[f64; 3]],
+        body_of_node: &[u32],
+    ) -> Self {
+        let mut max_face_size: f64 = 0.0;
+        let mut edge_sum = 0.0;
+        for f in &faces {
+            let [a, b, c] = f.nodes.map(|i| x[i]);
+            let edges = [norm(sub(b, a)), norm(sub(c, b)), norm(sub(a, c))];
+            max_face_size = max_face_size.max(edges[0].max(edges[1]).max(edges[2]));
+            edge_sum += edges[0] + edges[1] + edges[2];
+        }
+        let mut slot = vec![u32::MAX; x.len()];
         let mut nodes: Vec<usize> = faces.iter().flat_map(|f| f.nodes).collect();
         nodes.sort_unstable();
         nodes.dedup();
@@ -156,12 +170,18 @@ impl Surface {
         }
         let mut node_area = vec![0.0; nodes.len()];
         let mut node_stiffness = vec![0.0; nodes.len()];
+        let mut node_half_thickness = vec![0.0; nodes.len()];
         for f in &faces {
             for &i in &f.nodes {
                 let s = slot[i] as usize;
                 node_area[s] += f.area / 3.0;
                 node_stiffness[s] += f.stiffness / 3.0;
+                node_half_thickness[s] += f.half_thickness * f.area / 3.0;
             }
+        }
+        // a node's half thickness: the area-weighted mean of its faces' (0 for solids)
+        for (h, a) in node_half_thickness.iter_mut().zip(&node_area) {
+            *h /= a;
         }
         let mean_edge = if faces.is_empty() {
             0.0
@@ -169,8 +189,7 @@ impl Surface {
             edge_sum / (3.0 * faces.len() as f64)
         };
         let node_body = nodes.iter().map(|&i| body_of_node[i]).collect();
-        let node_half_thickness = vec![0.0; nodes.len()];
-        Ok(Self {
+        Self {
             faces,
             nodes,
             slot,
@@ -180,6 +199,6 @@ impl Surface {
             node_half_thickness,
             max_face_size,
             mean_edge,
-        })
+        }
     }
 }
