@@ -7,7 +7,7 @@
 
 mod common;
 
-use common::grid;
+use common::{alternating_triangles, grid};
 use demfem::error::DemfemError;
 use demfem::fem::contact::{
     ContactModel, ContactSettings, NoTensionSpring, RigidShape, RigidSurface,
@@ -31,20 +31,7 @@ fn tube(nc: usize, nl: usize, r: f64, l: f64, h: f64, cy: f64, cz: f64) -> TriMe
             nodes.push([l * j as f64 / nl as f64, cy + r * a.cos(), cz + r * a.sin()]);
         }
     }
-    let id = |i: usize, j: usize| j * nc + i % nc;
-    let mut triangles = Vec::new();
-    for j in 0..nl {
-        for i in 0..nc {
-            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
-            if (i + j) % 2 == 0 {
-                triangles.push([a, b, c]);
-                triangles.push([a, c, d]);
-            } else {
-                triangles.push([a, b, d]);
-                triangles.push([b, c, d]);
-            }
-        }
-    }
+    let triangles = alternating_triangles(nc, nl, |i, j| j * nc + i % nc);
     let thickness = vec![h; triangles.len()];
     TriMesh {
         nodes,

@@ -12,7 +12,22 @@ pub fn grid(n: usize, m: usize, h: f64, f: impl Fn(f64, f64) -> [f64; 3]) -> Tri
             nodes.push(f(i as f64 / n as f64, j as f64 / m as f64));
         }
     }
-    let id = |i: usize, j: usize| j * (n + 1) + i;
+    let triangles = alternating_triangles(n, m, |i, j| j * (n + 1) + i);
+    let thickness = vec![h; triangles.len()];
+    TriMesh {
+        nodes,
+        triangles,
+        thickness,
+    }
+}
+
+/// Two triangles per cell of an `n`×`m` grid of cells, cut by alternating diagonals; `id(i, j)`
+/// numbers the node at column i, row j (i up to n, j up to m; a closed tube wraps i).
+pub fn alternating_triangles(
+    n: usize,
+    m: usize,
+    id: impl Fn(usize, usize) -> usize,
+) -> Vec<[usize; 3]> {
     let mut triangles = Vec::new();
     for j in 0..m {
         for i in 0..n {
@@ -26,10 +41,5 @@ pub fn grid(n: usize, m: usize, h: f64, f: impl Fn(f64, f64) -> [f64; 3]) -> Tri
             }
         }
     }
-    let thickness = vec![h; triangles.len()];
-    TriMesh {
-        nodes,
-        triangles,
-        thickness,
-    }
+    triangles
 }
