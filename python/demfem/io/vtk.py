@@ -45,6 +45,22 @@ def _data_array(vtk_type: str, values: np.ndarray, name: str | None, components:
             f'format="ascii">{_ascii(values)}</DataArray>')
 
 
+def _arrays(data: Mapping[str, np.ndarray] | None, n: int, what: str) -> list[str]:
+    """The XML arrays of ``data`` (name -> (n,) or (n, k) values), checked against ``n``."""
+    out = []
+    for name, values in (data or {}).items():
+        if not isinstance(name, str) or not name:
+            raise InvalidParameterError(f"invalid {what} name = {name!r}: must be a non-empty "
+                                        "string")
+        values = np.asarray(values)
+        if values.ndim not in (1, 2) or values.shape[0] != n:
+            raise ShapeError(f"shape mismatch for {what}[{name!r}]: expected ({n},) or "
+                             f"({n}, k), got {values.shape}")
+        vtk_type, values = _vtk_type(values, name)
+        out.append(_data_array(vtk_type, values, name, 1 if values.ndim == 1 else values.shape[1]))
+    return out
+
+
 def write_vtp(path: str | Path, positions: np.ndarray,
               point_data: Mapping[str, np.ndarray] | None = None) -> Path:
     """Write one particle snapshot as VTK PolyData; returns the path.
@@ -63,18 +79,7 @@ def write_vtp(path: str | Path, positions: np.ndarray,
         raise InvalidParameterError(
             "invalid positions: must be finite (drop removed spheres before writing)")
     n = len(pos)
-    arrays = []
-    for name, values in (point_data or {}).items():
-        if not isinstance(name, str) or not name:
-            raise InvalidParameterError(f"invalid point_data name = {name!r}: must be a "
-                                        "non-empty string")
-        values = np.asarray(values)
-        if values.ndim not in (1, 2) or values.shape[0] != n:
-            raise ShapeError(f"shape mismatch for point_data[{name!r}]: expected ({n},) or "
-                             f"({n}, k), got {values.shape}")
-        vtk_type, values = _vtk_type(values, name)
-        components = 1 if values.ndim == 1 else values.shape[1]
-        arrays.append(_data_array(vtk_type, values, name, components))
+    arrays = _arrays(point_data, n, "point_data")
     index = np.arange(n, dtype=np.int64)
     text = "\n".join([
         '<?xml version="1.0"?>',
@@ -92,21 +97,6 @@ def write_vtp(path: str | Path, positions: np.ndarray,
         "</Piece>", "</PolyData>", "</VTKFile>", "",
     ])
     return write_text_atomic(path, text)
-
-
-def _arrays(data: Mapping[str, np.ndarray] | None, n: int, what: str) -> list[str]:
-    out = []
-    for name, values in (data or {}).items():
-        if not isinstance(name, str) or not name:
-            raise InvalidParameterError(f"invalid {what} name = {name!r}: must be a non-empty "
-                                        "string")
-        values = np.asarray(values)
-        if values.ndim not in (1, 2) or values.shape[0] != n:
-            raise ShapeError(f"shape mismatch for {what}[{name!r}]: expected ({n},) or "
-                             f"({n}, k), got {values.shape}")
-        vtk_type, values = _vtk_type(values, name)
-        out.append(_data_array(vtk_type, values, name, 1 if values.ndim == 1 else values.shape[1]))
-    return out
 
 
 def write_vtu_triangles(path: str | Path, points: np.ndarray, triangles: np.ndarray,
