@@ -22,13 +22,15 @@
 //! mode. At n = 0, v^{−½} := v^0 − (Δt/2) a^0.
 
 mod state;
+mod tet_kernel;
+
+pub use tet_kernel::TetForceKernel;
 
 use rayon::prelude::*;
 
 use crate::error::{check_non_negative, check_open, check_positive, DemfemError, Result};
-use crate::fem::assembly::{lumped_mass, precompute_tets, NodeAdjacency};
+use crate::fem::assembly::lumped_mass;
 use crate::fem::contact::{ContactEnergy, ContactModel};
-use crate::fem::element::Tet4;
 use crate::fem::material::LinearElastic;
 use crate::fem::mesh::{tet_quality, TetMesh};
 use crate::fem::stable_step::{
@@ -36,8 +38,6 @@ use crate::fem::stable_step::{
     EigenvalueBound, StepBound,
 };
 
-/// Elements per parallel work item (fixed, so chunking does not depend on the thread count).
-const ELEMENT_CHUNK: usize = 2048;
 /// Nodes per parallel work item.
 const NODE_CHUNK: usize = 2048;
 
@@ -189,118 +189,6 @@ impl EnergyReport {
         } else {
             0.0
         }
-    }
-}
-
-/// Element-force kernel: precomputed tets, 32-bit connectivity and the node adjacency.
-#[derive(Debug, Clone)]
-pub struct TetForceKernel {
-    tets: Vec<Tet4>,
-    conn: Vec<[u32; 4]>,
-    adjacency: NodeAdjacency,
-    lambda: f64,
-    mu: f64,
-    buffer: Vec<[f64; 3]>,
-}
-
-impl TetForceKernel {
-    /// Precompute for `mesh` with Lamé constants `lambda`, `mu` (Pa).
-    pub fn new(mesh: &TetMesh, lambda: f64, mu: f64) -> Result<Self> {
-        mesh.validate()?;
-        if mesh.nodes.len() >= u32::MAX as usize {
-            return Err(DemfemError::ShapeMismatch {
-                field: "mesh.nodes".into(),
-                detail: "too many nodes for 32-bit indices".into(),
-            });
-        }
-        let tets = precompute_tets(mesh)?;
-        let conn = mesh.tets.iter().map(|t| t.map(|i| i as u32)).collect();
-        let adjacency = NodeAdjacency::new(&mesh.tets, mesh.nodes.len())?;
-        Ok(Self {
-            tets,
-            conn,
-            adjacency,
-            lambda,
-            mu,
-            buffer: vec![[0.0; 3]; mesh.tets.len() * 4],
-        })
-    }
-
-    /// Precomputed element geometry.
-    pub fn tets(&self) -> &[Tet4] {
-        &self.tets
-    }
-
-    /// Number of elements.
-    pub fn n_elements(&self) -> usize {
-        self.tets.len()
-    }
-
-    /// Nodal forces K·`u` (N) for nodal displacements `u` (m), written into `out`; no
-    /// allocation. `u` and `out` must have one entry per node.
-    pub fn apply(&mut self, u: &[[f64; 3]], out: &mut [[f64; 3]]) {
-        let (lambda, mu) = (self.lambda, self.mu);
-        let tets = &self.tets;
-        let conn = &self.conn;
-        self.buffer
-            .par_chunks_mut(4 * ELEMENT_CHUNK)
-            .enumerate()
-            .for_each(|(c, chunk)| {
-                let e0 = c * ELEMENT_CHUNK;
-                for (k, out_e) in chunk.chunks_exact_mut(4).enumerate() {
-                    let e = e0 + k;
-                    tet_force(&tets[e], conn[e], u, lambda, mu, out_e);
-                }
-            });
-        let buffer = &self.buffer;
-        let adj = &self.adjacency;
-        out.par_chunks_mut(NODE_CHUNK)
-            .enumerate()
-            .for_each(|(c, chunk)| {
-                let n0 = c * NODE_CHUNK;
-                for (k, f) in chunk.iter_mut().enumerate() {
-                    let n = n0 + k;
-                    let mut s = [0.0; 3];
-                    for &en in &adj.entries[adj.offsets[n] as usize..adj.offsets[n + 1] as usize] {
-                        let b = buffer[en as usize];
-                        s[0] += b[0];
-                        s[1] += b[1];
-                        s[2] += b[2];
-                    }
-                    *f = s;
-                }
-            });
-    }
-}
-
-/// Nodal forces V σ ∇N_a of one constant-strain tet (the hot loop: no allocation).
-#[inline(always)]
-fn tet_force(t: &Tet4, n: [u32; 4], u: &[[f64; 3]], lambda: f64, mu: f64, out: &mut [[f64; 3]]) {
-    let g = &t.grads;
-    let mut h = [[0.0f64; 3]; 3];
-    for a in 0..4 {
-        let ua = u[n[a] as usize];
-        for i in 0..3 {
-            h[i][0] += ua[i] * g[a][0];
-            h[i][1] += ua[i] * g[a][1];
-            h[i][2] += ua[i] * g[a][2];
-        }
-    }
-    let lv = lambda * (h[0][0] + h[1][1] + h[2][2]) * t.volume;
-    let mv = mu * t.volume;
-    let s00 = lv + 2.0 * mv * h[0][0];
-    let s11 = lv + 2.0 * mv * h[1][1];
-    let s22 = lv + 2.0 * mv * h[2][2];
-    let s12 = mv * (h[1][2] + h[2][1]);
-    let s02 = mv * (h[0][2] + h[2][0]);
-    let s01 = mv * (h[0][1] + h[1][0]);
-    for a in 0..4 {
-        let ga = g[a];
-        out[a] = [
-            s00 * ga[0] + s01 * ga[1] + s02 * ga[2],
-            s01 * ga[0] + s11 * ga[1] + s12 * ga[2],
-            s02 * ga[0] + s12 * ga[1] + s22 * ga[2],
-        ];
     }
 }
 

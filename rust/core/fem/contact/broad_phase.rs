@@ -1,14 +1,20 @@
 //! Broad phase: a uniform cell grid over the surface faces' bounding boxes, inflated by a
 //! travel margin. Each surface node gets the list of faces of other bodies whose inflated
-//! box holds it. The lists stay valid while no node has moved more than half the margin
-//! since they were built (two surfaces then close by at most the margin), so they are
-//! rebuilt only when that happens.
+//! box holds it and whose triangle is within the face's contact depth plus the margin of
+//! it. The lists stay valid while no node has moved more than half the margin since they
+//! were built (a node and every point of a face then close by at most the margin, and a
+//! node in contact is within the depth of its face), so they are rebuilt only when that
+//! happens. The faces in some list are the live faces: only their geometry is updated per
+//! step.
 //!
 //! Cells are keyed by integer coordinates in a hash map, so far-apart bodies cost no
 //! memory between them; a coordinate beyond ±2⁶² cells saturates instead of overflowing.
 
 use std::collections::HashMap;
 
+use rayon::prelude::*;
+
+use super::narrow::closest_point_on_triangle;
 use super::surface::Surface;
 
 /// Candidate faces per surface node.
@@ -22,6 +28,8 @@ pub struct BroadPhase {
     pub built_at: Vec<[f64; 3]>,
     /// Number of builds so far.
     pub builds: u64,
+    /// Faces in at least one list, ascending.
+    pub live: Vec<u32>,
     /// Travel margin, m.
     pub margin: f64,
 }
@@ -50,7 +58,7 @@ impl BroadPhase {
             return true;
         }
         let lim = 0.25 * self.margin * self.margin;
-        surface.nodes.iter().zip(&self.built_at).any(|(&i, b)| {
+        surface.nodes.par_iter().zip(&self.built_at).any(|(&i, b)| {
             let d = [u[i][0] - b[0], u[i][1] - b[1], u[i][2] - b[2]];
             !(d[0] * d[0] + d[1] * d[1] + d[2] * d[2] <= lim)
         })
@@ -117,7 +125,15 @@ impl BroadPhase {
                         continue;
                     }
                     let (a, b) = (lo[f as usize], hi[f as usize]);
-                    if (0..3).all(|d| p[d] >= a[d] && p[d] <= b[d]) {
+                    if !(0..3).all(|d| p[d] >= a[d] && p[d] <= b[d]) {
+                        continue;
+                    }
+                    // Within the face's depth (with a relative 1e-6 to spare for the
+                    // narrow phase's edge tolerance) plus the margin of the triangle.
+                    let (q, _) = closest_point_on_triangle(p, face.nodes.map(|i| x[i]));
+                    let e = [p[0] - q[0], p[1] - q[1], p[2] - q[2]];
+                    let reach = m + face.depth * (1.0 + 1e-6) + 1e-12;
+                    if !(e[0] * e[0] + e[1] * e[1] + e[2] * e[2] > reach * reach) {
                         self.candidates.push(f);
                     }
                 }
@@ -126,6 +142,15 @@ impl BroadPhase {
         }
         self.built_at = surface.nodes.iter().map(|&i| u[i]).collect();
         self.builds += 1;
+        self.refresh_live();
+    }
+
+    /// Recompute [`Self::live`] from the lists (after a rebuild or a restore).
+    pub fn refresh_live(&mut self) {
+        let mut live = self.candidates.clone();
+        live.sort_unstable();
+        live.dedup();
+        self.live = live;
     }
 
     /// Candidate faces of surface node `k` (its position in `Surface::nodes`).

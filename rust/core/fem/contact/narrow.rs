@@ -13,8 +13,13 @@
 //! carried over through the sign of the two normals' dot product); a node found on the
 //! other side of the face's inside has crossed the mid-surface and is not in contact.
 
+use rayon::prelude::*;
+
 use super::vec3::{add, cross, dot, norm, scale, sub};
 use super::{ContactModel, RECENT_STEPS};
+
+/// Faces per parallel work item of the per-step face geometry.
+const FACE_CHUNK: usize = 1024;
 
 /// A contact found: face, penetration (m), weights of the contact point on the face, side
 /// σ (±1; 1 for solids), unit contact normal pointing towards the node.
@@ -22,7 +27,7 @@ pub(super) type Found = (usize, f64, [f64; 3], f64, [f64; 3]);
 
 /// The point of triangle `t` nearest to `p` and its barycentric weights (Ericson,
 /// *Real-Time Collision Detection*, 5.1.5).
-fn closest_point_on_triangle(p: [f64; 3], t: [[f64; 3]; 3]) -> ([f64; 3], [f64; 3]) {
+pub(super) fn closest_point_on_triangle(p: [f64; 3], t: [[f64; 3]; 3]) -> ([f64; 3], [f64; 3]) {
     let [a, b, c] = t;
     let ab = sub(b, a);
     let ac = sub(c, a);
@@ -86,7 +91,8 @@ impl ContactModel {
         scale(nrm, 1.0 / norm(nrm))
     }
 
-    /// Recompute [`FaceGeom`] of every face from the current positions `x`. The reach is
+    /// Recompute [`FaceGeom`] of every live face (in some node's candidate list; no other
+    /// is read) from the current positions `x`. The reach is
     /// the whole element height behind a solid face (the initial-overlap check's depth
     /// fraction 1) and half the face's [`super::SurfaceFace::depth`] plus the largest node
     /// half thickness on a shell face, with 1 % and 1e-12 m to spare.
@@ -94,31 +100,42 @@ impl ContactModel {
         let hn_max = self
             .surface
             .node_half_thickness
-            .iter()
-            .fold(0.0f64, |m, &h| m.max(h));
+            .par_iter()
+            .cloned()
+            .reduce(|| 0.0, f64::max);
         let mut geom = std::mem::take(&mut self.face_geom);
         geom.resize(self.surface.faces.len(), FaceGeom::default());
-        for (g, face) in geom.iter_mut().zip(&self.surface.faces) {
-            let [a, b, c] = face.nodes.map(|i| self.x[i]);
-            let nrm = cross(sub(b, a), sub(c, a));
-            let area2 = norm(nrm);
-            let centre = scale(add(add(a, b), c), 1.0 / 3.0);
-            let r = [a, b, c]
-                .iter()
-                .map(|&p| norm(sub(p, centre)))
-                .fold(0.0f64, f64::max);
-            let reach = if face.half_thickness > 0.0 {
-                face.half_thickness + hn_max
-            } else {
-                face.depth
-            };
-            let rr = 1.01 * (r + reach) + 1e-12;
-            *g = FaceGeom {
-                normal: scale(nrm, 1.0 / area2),
-                area2,
-                centre,
-                radius2: rr * rr,
-            };
+        let (x, faces) = (&self.x, &self.surface.faces);
+        let live = &self.broad.live;
+        let fresh: Vec<FaceGeom> = live
+            .par_iter()
+            .with_min_len(FACE_CHUNK)
+            .map(|&f| {
+                let face = &faces[f as usize];
+                let [a, b, c] = face.nodes.map(|i| x[i]);
+                let nrm = cross(sub(b, a), sub(c, a));
+                let area2 = norm(nrm);
+                let centre = scale(add(add(a, b), c), 1.0 / 3.0);
+                let r = [a, b, c]
+                    .iter()
+                    .map(|&p| norm(sub(p, centre)))
+                    .fold(0.0f64, f64::max);
+                let reach = if face.half_thickness > 0.0 {
+                    face.half_thickness + hn_max
+                } else {
+                    face.depth
+                };
+                let rr = 1.01 * (r + reach) + 1e-12;
+                FaceGeom {
+                    normal: scale(nrm, 1.0 / area2),
+                    area2,
+                    centre,
+                    radius2: rr * rr,
+                }
+            })
+            .collect();
+        for (&f, g) in live.iter().zip(fresh) {
+            geom[f as usize] = g;
         }
         self.face_geom = geom;
     }

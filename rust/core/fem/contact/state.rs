@@ -142,6 +142,7 @@ impl ContactModel {
         self.broad.candidates = candidates;
         self.broad.built_at = built_at;
         self.broad.builds = builds[0];
+        self.broad.refresh_live();
         self.failure = None;
         Ok(())
     }
