@@ -444,9 +444,12 @@ def _finite_and_within_the_step(r) -> None:
 def test_fem_contact_with_a_100x_penalty_point_contact():
     """Two soft tubes collide crossed (a point contact) at the OpenRadioss default penalty
     (s = 1) and at 100x it. The stiffer penalty takes a smaller step (the certified limit
-    counts the contact springs), penetrates far less, gives a peak force within 15 % of the
-    default's (the force converges with s), stays finite and keeps the energy balance
-    within 1 %; the step never exceeds the certified limit."""
+    counts the contact springs), penetrates far less, gives the default's impulse within
+    10 % and its restitution within 0.02 (the contact converges with s), a peak force within
+    25 %, stays finite and keeps the energy balance within 1 %; the step never exceeds the
+    certified limit. The stiff contact chatters and its peak follows round-off: two builds
+    that differ only in the order of each node's force sum gave +13 % and +21 % (impulse
+    +1.7 % and +4.1 %, restitution 0.889 both, against 0.898)."""
     runs = _collide_soft_tubes(90.0, (1.0, 100.0))
     for s, r in runs.items():
         _finite_and_within_the_step(r)
@@ -455,7 +458,10 @@ def test_fem_contact_with_a_100x_penalty_point_contact():
     assert stiff_p.dt < 0.5 * soft_p.dt and stiff_p.result.step["reduced_for_contact"]
     pen = {s: float(np.nanmax(r.result.max_penetration)) for s, r in runs.items()}
     assert pen[100.0] < 0.2 * pen[1.0], pen
-    assert stiff_p.max_force == pytest.approx(soft_p.max_force, rel=0.15)
+    impulse = {s: float(np.trapezoid(r.force, r.result.time)) for s, r in runs.items()}
+    assert impulse[100.0] == pytest.approx(impulse[1.0], rel=0.10), impulse
+    assert abs(stiff_p.restitution - soft_p.restitution) < 0.02
+    assert stiff_p.max_force == pytest.approx(soft_p.max_force, rel=0.25)
 
 
 def test_fem_contact_with_a_100x_penalty_line_contact_stays_bounded():
