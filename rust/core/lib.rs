@@ -9,6 +9,7 @@
 #![warn(missing_docs)]
 
 pub mod contact;
+pub mod cpu;
 pub mod dem;
 pub mod error;
 pub mod fem;

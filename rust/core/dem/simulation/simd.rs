@@ -12,17 +12,9 @@ use super::state::{Flips, PairContact, WallContact, WallDetail, WallOut};
 use super::wall::{wall_chunk, BlockWalls, WallCtx};
 use crate::geometry::Vec3;
 
-/// Whether the step may use its AVX2 build: the CPU has AVX2 and `DEMFEM_NO_AVX2` is unset
-/// (the variable forces the baseline build, e.g. to compare the two).
+/// Whether the step may use its AVX2 build ([`crate::cpu::has_avx2`]).
 pub(super) fn cpu_has_avx2() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::env::var_os("DEMFEM_NO_AVX2").is_none() && std::arch::is_x86_feature_detected!("avx2")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
+    crate::cpu::has_avx2()
 }
 
 /// `$name(avx2, args…)` calls `$inner::<E>(args…)`, through `$avx` (the same body

@@ -217,7 +217,6 @@ pub struct ContactModel {
     last_depth: Vec<f64>,
     offset: Vec<f64>,
     x: Vec<[f64; 3]>,
-    touched: Vec<usize>,
     // Per face, this step: unit normal, area ×2 and a bounding sphere (see `narrow`).
     face_geom: Vec<narrow::FaceGeom>,
     f_prev: Vec<[f64; 3]>,
@@ -314,7 +313,6 @@ impl ContactModel {
             last_depth: vec![0.0; ns],
             offset: vec![0.0; ns],
             x: vec![[0.0; 3]; n],
-            touched: surface.nodes.clone(),
             face_geom: Vec::new(),
             f_prev: vec![[0.0; 3]; n],
             u_prev: vec![[0.0; 3]; n],
@@ -347,11 +345,6 @@ impl ContactModel {
             s.validate(self.reference.len())?;
         }
         self.springs.extend_from_slice(springs);
-        let mut t = self.surface.nodes.clone();
-        t.extend(self.springs.iter().map(|s| s.node));
-        t.sort_unstable();
-        t.dedup();
-        self.touched = t;
         Ok(())
     }
 
@@ -520,7 +513,7 @@ impl ContactModel {
         Ok(())
     }
 
-    /// Current positions x = X + u of every node (only the touched nodes are read).
+    /// Current positions x = X + u of every node (only surface and spring nodes are read).
     fn update_positions(&mut self, u: &[[f64; 3]]) {
         self.x
             .par_chunks_mut(NODE_CHUNK)
@@ -602,6 +595,7 @@ impl ContactModel {
                                     stick[k],
                                     n,
                                     vrel,
+                                    [0.0; 3],
                                     d - offset,
                                     face.stiffness,
                                     mu,
@@ -629,21 +623,16 @@ impl ContactModel {
                             if let Some((d, n, vs)) = s.probe_offset(this.x[i], t, hn) {
                                 let kn = this.surface.node_stiffness[k];
                                 let vrel = sub(v[i], vs);
-                                let mut h = friction_update(
+                                let h = friction_update(
                                     stick_rigid[k * nr + r],
                                     n,
                                     vrel,
+                                    vs,
                                     d,
                                     kn,
                                     s.friction,
                                     dt,
                                 );
-                                // The surface's work is counted with this step's force
-                                // (below), the spring's travel with the mean force: the
-                                // change of force times v_s Δt / 2 closes the step.
-                                if h.3 != 0.0 {
-                                    h.3 += 0.5 * dot(sub(h.1, h.4), vs) * dt;
-                                }
                                 // Power the moving surface puts into the body: F·v_s.
                                 let work = dot(add(h.0, h.1), vs) * dt;
                                 out.push(Hit {
@@ -668,7 +657,8 @@ impl ContactModel {
                 })
                 .collect()
         };
-        // Deterministic scatter, in node order. Only touched nodes ever carry a force.
+        // Deterministic scatter, in node order. Only surface and spring nodes ever carry a
+        // force.
         force
             .par_chunks_mut(NODE_CHUNK)
             .for_each(|c| c.fill([0.0; 3]));
@@ -792,7 +782,7 @@ impl ContactModel {
             }
         }
         // Work of all contact forces on the nodes, as the solver counts external work
-        // (untouched nodes carry no force and add nothing), summed per fixed chunk.
+        // (other nodes carry no force and add nothing), summed per fixed chunk.
         let partial: Vec<f64> = self
             .u_prev
             .par_chunks_mut(NODE_CHUNK)

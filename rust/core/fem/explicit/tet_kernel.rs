@@ -183,7 +183,7 @@ impl TetForceKernel {
             n_nodes: mesh.nodes.len(),
             lambda,
             mu,
-            avx2: cpu_has_avx2(),
+            avx2: crate::cpu::has_avx2(),
         })
     }
 
@@ -293,19 +293,6 @@ unsafe fn block_body(
         for a in 0..4 {
             shared.add(n[a] as usize, f[a]);
         }
-    }
-}
-
-/// Whether the kernel may use its AVX2 build: the CPU has AVX2 and `DEMFEM_NO_AVX2` is
-/// unset (the variable forces the baseline build, e.g. to compare the two).
-fn cpu_has_avx2() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::env::var_os("DEMFEM_NO_AVX2").is_none() && std::arch::is_x86_feature_detected!("avx2")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
     }
 }
 
