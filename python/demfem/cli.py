@@ -266,10 +266,10 @@ def _cmd_assess(args: argparse.Namespace) -> int:
                     full=args.full, throughput=args.throughput, fresh=args.fresh,
                     threads=args.threads, stress_model=model, refeed=not args.no_refeed,
                     progress=True, log=lambda line: print(line, flush=True))
-    s = result["summary"]
-    print(f"P per passage: mean {s['p_passage_mean']:.3g}, max {s['p_passage_max']:.3g}; "
-          f"expected broken per hour: {s['broken_per_hour']:.3g} (report: {args.out}/"
-          "report.html)")
+    if "summary" in result:
+        from demfem.assess.headline import headline
+
+        print(headline(result["summary"]) + f" (report: {args.out}/report.html)")
     return 0
 
 
@@ -406,8 +406,9 @@ def build_parser() -> argparse.ArgumentParser:
     a.add_argument("--no-refeed", action="store_true", help="run the scene as a batch that "
                    "drains (default: cartridges leaving are re-fed upstream, so the table "
                    "reaches a steady state)")
-    a.add_argument("--throughput", type=float, default=6000.0, metavar="PER_HOUR",
-                   help="cartridges per hour through the table (6000, a planning assumption)")
+    a.add_argument("--throughput", type=float, default=None, metavar="PER_HOUR",
+                   help="cartridges per hour of your line; default: the table's own "
+                        "discharge in the simulation (given, the report shows both)")
     a.add_argument("--threads", type=int, default=min(2, os.cpu_count() or 1),
                    help="DEM engine threads (results are the same on any number)")
     a.add_argument("--fresh", "--overwrite", dest="fresh", action="store_true",

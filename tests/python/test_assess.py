@@ -20,7 +20,8 @@ from demfem.assess.closed_form import (closed_form_coefficients, patch_centre_co
 from demfem.assess.events import EVENT_DTYPE
 from demfem.assess.figures import FIGURES
 from demfem.assess.impact import ImpactLaw, cartridge_body, flat_partner, impact_duration
-from demfem.assess.risk_stage import (cartridge_risk, equivalent_stress, event_probabilities,
+from demfem.assess.passages import passages
+from demfem.assess.risk_stage import (equivalent_stress, event_probabilities, passage_risk,
                                       surface_probability)
 from demfem.assess.stress_stage import collision_stresses
 from demfem.cli import main
@@ -135,7 +136,7 @@ def _risk(speeds):
     ev = _synthetic_events(speeds)
     st = collision_stresses(ev["normal_speed"], ev["partner"], StressModel.default(), 45e9)
     p = event_probabilities(st)
-    return ev, st, p, cartridge_risk(ev, p["p_event"], 4, np.full(4, np.nan), (0.5, 1.0), 6000)
+    return ev, st, p, passage_risk(ev, p["p_event"], passages(4, [], []), (0.5, 1.0), 6000)
 
 
 def test_risk_rises_with_impact_speed():
@@ -147,7 +148,11 @@ def test_risk_rises_with_impact_speed():
     assert c2["broken_per_hour"] > c1["broken_per_hour"] > 0
     # small P: the hourly number is 3600 x the summed hazard rate of the population
     assert c1["broken_per_hour"] == pytest.approx(c1["broken_per_hour_small_p"], rel=1e-6)
-    assert c1["residence_time_s"] == pytest.approx(4 / (6000 / 3600))
+    # no cartridge left in the window: P per passage at the throughput given
+    assert c1["exits"] == 0 and c1["throughput_source"] == "user"
+    assert c1["p_passage"] == pytest.approx(c1["broken_per_hour_table"] / 6000, rel=1e-12)
+    assert c1["broken_per_hour"] == pytest.approx(c1["broken_per_hour_table"], rel=1e-12)
+    assert c1["mean_on_table"] == pytest.approx(4.0)
 
 
 def test_per_event_probabilities_match_demfem_risk():
@@ -245,7 +250,7 @@ def test_outputs_and_report(small_job):
 
     in_window = sum(r["in_window"] == "1" for r in rows)
     for name, count, field in (("events.vtp", min(in_window, 20_000), "p_event"),
-                               ("cartridges.vtp", SMALL.n_spheres, "p_passage")):
+                               ("cartridges.vtp", SMALL.n_spheres, "p_window")):
         piece = ET.parse(out / name).getroot().find("PolyData/Piece")
         assert int(piece.get("NumberOfPoints")) == count, name
         names = [a.get("Name") for a in piece.find("PointData")]
@@ -254,10 +259,20 @@ def test_outputs_and_report(small_job):
     assert walls and all(r["j"] == "-1" and int(r["wall"]) > 0 for r in walls)  # never the belt
     assert doc["events"]["n_wall_events"] == len(walls)
     assert 0.0 <= doc["summary"]["wall_share"] <= 1.0
-    cart = list(csv.DictReader(open(out / "cartridges.csv")))
-    assert len(cart) == SMALL.n_spheres
-    p = np.array([float(r["p_passage"]) for r in cart])
-    assert np.mean(p) == pytest.approx(doc["summary"]["p_passage_mean"], rel=1e-5)
+    # every hourly figure is one number: passages.csv, risk.json's three and the report's
+    rows_p = list(csv.DictReader(open(out / "passages.csv")))
+    assert len(rows_p) >= SMALL.n_spheres
+    s = doc["summary"]
+    w = doc["window_s"][1] - doc["window_s"][0]
+    from_csv = 3600.0 * sum(float(r["p_window"]) for r in rows_p) / w
+    assert from_csv == pytest.approx(s["broken_per_hour_table"], rel=1e-7)
+    assert s["broken_per_hour_small_p"] == pytest.approx(s["broken_per_hour_table"], rel=1e-6)
+    assert s["broken_per_hour"] == s["broken_per_hour_table"]
+    assert s["unassigned_events"] == 0
+    exposure = sum(float(r["exposure_in_window_s"]) for r in rows_p)
+    assert exposure / w == pytest.approx(s["mean_on_table"], rel=1e-7)
+    from demfem.assess.headline import fmt
+    assert fmt(s["broken_per_hour"]) in (out / "report.html").read_text()
     html_text = (out / "report.html").read_text()
     imgs = re.findall(r'<img src="data:image/png;base64,([A-Za-z0-9+/=]+)"', html_text)
     assert len(imgs) == len(FIGURES)
@@ -335,7 +350,7 @@ def test_cli_assess_quick(tmp_path, capsys):
     out = tmp_path / "q"
     assert main(["assess", "--quick", "--out", str(out)]) == 0
     assert (out / "report.html").exists() and (out / "risk.json").exists()
-    assert "expected broken per hour" in capsys.readouterr().out
+    assert "Expected broken cartridges per hour" in capsys.readouterr().out
     assert main(["assess", "--quick", "--out", str(out), "--throughput", "10"]) == 2
     err = capsys.readouterr().err
     assert err.startswith("demfem: error:") and "throughput_per_hour" in err
@@ -351,7 +366,7 @@ def test_cli_assess_quick(tmp_path, capsys):
                  str(tmp_path / "half.json")]) == 0
     lower = json.loads((tmp_path / "h" / "risk.json").read_text())["summary"]
     first = json.loads((out / "risk.json").read_text())["summary"]
-    assert lower["p_passage_mean"] < first["p_passage_mean"]
+    assert lower["broken_per_hour_table"] < first["broken_per_hour_table"]
 
 
 def test_stress_model_refit_from_a_grid_of_fem_collisions(tmp_path):

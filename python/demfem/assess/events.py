@@ -40,7 +40,7 @@ import numpy as np
 
 from demfem.errors import check_range
 
-__all__ = ["EVENT_DTYPE", "DEFAULT_MIN_SPEED", "NOT_IMPACTS", "impact_events",
+__all__ = ["EVENT_DTYPE", "DEFAULT_MIN_SPEED", "NOT_IMPACTS", "impact_events", "count_line",
            "events_of_cartridge", "events_per_cartridge", "write_events_csv"]
 
 #: Walls whose contacts are not side impacts on a cartridge (the floor it stands on).
@@ -53,12 +53,15 @@ DEFAULT_MIN_SPEED = 5e-3
 #: 1 wall), the wall's index in the run's ``info["wall_names"]`` (-1 for a sphere), onset
 #: time (s), contact point (m), normal and tangential relative speed at onset (m/s), impact
 #: angle atan2(v_t, v_n) (rad); measured in the DEM (``measured``; NaN otherwise): peak
-#: normal force (N), contact duration (s), normal impulse (N s).
+#: normal force (N), contact duration (s), normal impulse (N s), peak tangential (friction)
+#: force (N); ``pressed``: kept for its force although it began slower than the minimum
+#: speed (a contact pressed by the queue, not an impact).
 EVENT_DTYPE = np.dtype([
     ("i", "i8"), ("j", "i8"), ("partner", "i8"), ("wall", "i8"), ("time", "f8"),
     ("x", "f8"), ("y", "f8"), ("z", "f8"),
     ("normal_speed", "f8"), ("tangential_speed", "f8"), ("impact_angle", "f8"),
     ("peak_force", "f8"), ("duration", "f8"), ("impulse", "f8"), ("measured", "?"),
+    ("peak_tangential_force", "f8"), ("pressed", "?"),
 ])
 
 
@@ -103,7 +106,7 @@ def impact_events(run, min_speed: float = DEFAULT_MIN_SPEED,
     for k in ("i", "j", "time", "normal_speed", "tangential_speed", "impact_angle"):
         ev[k] = sel[k]
     ev["partner"], ev["wall"] = 0, -1
-    ev["peak_force"] = ev["duration"] = ev["impulse"] = np.nan
+    ev["peak_force"] = ev["duration"] = ev["impulse"] = ev["peak_tangential_force"] = np.nan
     if len(sel):
         t = np.asarray(sel["time"], float)
         ci = _centres_at(run, t, np.asarray(sel["i"]))
@@ -129,6 +132,7 @@ def impact_events(run, min_speed: float = DEFAULT_MIN_SPEED,
         wev[k] = ws[k]
     wev["j"], wev["partner"] = -1, 1
     wev["peak_force"] = wev["duration"] = wev["impulse"] = np.nan
+    wev["peak_tangential_force"] = np.nan
     ev = np.concatenate([ev, wev])
     ev = ev[np.argsort(ev["time"], kind="stable")]
     dropped = np.concatenate([np.asarray(o["normal_speed"], float)[~keep],
@@ -140,10 +144,23 @@ def impact_events(run, min_speed: float = DEFAULT_MIN_SPEED,
                         names, measured=False)
 
 
+def count_line(summary: dict[str, Any]) -> str:
+    """The events stage's counts in the one scheme the console and the report share:
+    onsets = belt contacts + slower than the filter + events (pressed ones included)."""
+    s = summary
+    return (f"{s['n_onsets']} contact onsets = {s['n_belt_contacts']} with the belt (a "
+            f"cartridge standing on it, not an impact) + {s['n_dropped']} slower than "
+            f"{s['min_speed_m_per_s']:g} m/s (dropped) + {s['n_events']} events "
+            f"({s['n_events'] - s.get('n_wall_events', 0)} between cartridges, "
+            f"{s.get('n_wall_events', 0)} with walls and gate; {s.get('n_pressed', 0)} of them "
+            "slower but pressed by the queue)")
+
+
 def _summary(n_onsets: int, ev: np.ndarray, n_wall: int, per_wall: dict[str, int], n_belt: int,
              dropped: np.ndarray, v_min: float, names: list[str], measured: bool
              ) -> dict[str, Any]:
     return {"n_onsets": int(n_onsets), "n_events": int(len(ev)),
+            "n_pressed": int(np.sum(ev["pressed"])),
             "n_wall_events": n_wall, "wall_events": per_wall,
             "n_belt_contacts": n_belt,
             "n_dropped": int(len(dropped)),
@@ -180,6 +197,8 @@ def _measured_events(run, v_min: float, f_min: float) -> tuple[np.ndarray, dict[
     ev["impact_angle"] = np.arctan2(sel["tangential_speed"], sel["normal_speed"])
     ev["peak_force"], ev["duration"] = sel["peak_normal_force"], sel["duration"]
     ev["impulse"], ev["measured"] = sel["normal_impulse"], True
+    ev["peak_tangential_force"] = sel["peak_tangential_force"]
+    ev["pressed"] = sel["normal_speed"] < v_min
     ev = ev[np.argsort(ev["time"], kind="stable")]
     per_wall = {n: int(np.sum(w & (sel["j"] == k))) for k, n in enumerate(names)
                 if n not in NOT_IMPACTS}

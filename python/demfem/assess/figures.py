@@ -21,9 +21,9 @@ FIGURES = {
                           "with its two halves' mean rates (steadiness check).",
     "stress_model.png": "The stress model: peak σ1 on the inner and outer surface against "
                         "peak contact force, and the window's events on the inner line.",
-    "cartridge_risk.png": "Breakage probability per passage of each cartridge on the table "
-                          "(log scale; cartridges without any risk-bearing event at the left "
-                          "edge).",
+    "cartridge_risk.png": "Breakage probability of each passage (a cartridge from insertion "
+                          "to exit) over its time in the statistics window (log scale; "
+                          "passages without any risk-bearing event are not drawn).",
 }
 
 
@@ -36,7 +36,7 @@ def _png(fig) -> bytes:
 def make_figures(out: Path, data: dict[str, Any]) -> dict[str, bytes]:
     """Draw every figure of :data:`FIGURES` from ``data`` (the risk stage's arrays: ``map``,
     ``onset_speeds``, ``events``, ``window``, ``min_speed``, ``stress``, ``model``,
-    ``p_passage``, ``steady``), write each PNG into ``out`` atomically and return
+    ``p_window``, ``steady``), write each PNG into ``out`` atomically and return
     {file name: PNG bytes}."""
     import matplotlib
 
@@ -123,15 +123,15 @@ def make_figures(out: Path, data: dict[str, Any]) -> dict[str, bytes]:
 
     # per-cartridge risk
     fig, ax = plt.subplots(figsize=(6, 3.2))
-    p = np.asarray(data["p_passage"], float)
+    p = np.asarray(data["p_window"], float)
     pos = p[p > 0]
     if pos.size:
         lo = np.log10(pos)
         ax.hist(lo, bins=40, color="C1")
         ax.axvline(np.log10(max(np.mean(p), 1e-300)), color="k", ls="--", lw=1, label="mean")
         ax.legend(fontsize=8)
-    ax.set_xlabel("log10 P per passage (dimensionless)")
-    ax.set_ylabel("cartridges")
+    ax.set_xlabel("log10 P of each passage over its time in the window (dimensionless)")
+    ax.set_ylabel("passages")
     figs["cartridge_risk.png"] = _png(fig)
     plt.close(fig)
 

@@ -51,31 +51,49 @@ def render_report(risk: dict[str, Any], figures: dict[str, bytes],
              "&rarr; stress model &rarr; Weibull risk. SI units throughout.</p>"]
     for w in risk["warnings"]:
         parts.append(f"<p class='warn'>{html.escape(w)}</p>")
+    from demfem.assess.headline import fmt, headline
+
+    parts.append(f"<p class='headline'><b>{html.escape(headline(s))}</b></p>")
     parts.append("<h2>Summary</h2>")
-    parts.append(_table([
-        ("statistics window, s", f"{st['window_s'][0]:.4g} – {st['window_s'][1]:.4g}"),
-        ("cartridges on the table (mean over the window)", s["mean_on_table"]),
-        ("impact events in the window (normal speed ≥ min speed)", s["n_events_window"]),
-        ("collision rate, events/s", s["event_rate_per_s"]),
-        ("P per cartridge over the window: mean", s["p_window_mean"]),
-        ("P per cartridge over the window: max", s["p_window_max"]),
-        ("residence time on the table (Little's law), s", s["residence_time_s"]),
-        ("P per passage: mean", s["p_passage_mean"]),
-        ("P per passage: max", s["p_passage_max"]),
-        ("throughput (planning assumption), cartridges/h", s["throughput_per_hour"]),
-        ("expected broken per hour, 1/h", s["broken_per_hour"]),
-        ("share of the hazard from the inner surface", s["inner_share"]),
-        ("impacts on walls and gate in the window", s["n_wall_events_window"]),
-        ("share of the hazard from wall and gate impacts", s["wall_share"]),
-        ("largest peak contact force in the window, N", s["max_force_N"]),
-        ("largest inner σ1 in the window, Pa", s["max_sigma_inner_Pa"]),
-        ("largest outer σ1 in the window, Pa", s["max_sigma_outer_Pa"]),
-    ], cls="summary"))
-    parts.append("<h2>Worst collisions</h2><table><tr><th>event</th><th>cartridge – partner</th>"
+    rows = [
+        ("statistics window, s", f"{fmt(st['window_s'][0])} – {fmt(st['window_s'][1])}"),
+        ("cartridges on the table (mean over the window)", fmt(s["mean_on_table"])),
+        ("cartridges that left through the opening in the window", fmt(s["exits_window"])),
+        ("the table's own discharge, cartridges/h", fmt(s["discharge_per_hour"])),
+        ("residence time on the table (Little's law), s", fmt(s["residence_time_s"])),
+        ("passages (cartridges from insertion to exit) on the table in the window",
+         fmt(s["passages_in_window"])),
+        ("impact events in the window", fmt(s["n_events_window"])),
+        ("collision rate, events/s", fmt(s["event_rate_per_s"])),
+        ("probability that one passage breaks", fmt(s["p_passage"])),
+        ("largest P of one passage over its time in the window", fmt(s["p_window_max"])),
+        ("expected broken per hour at the table's own discharge, 1/h",
+         fmt(s["broken_per_hour_table"])),
+    ]
+    if s.get("throughput_source") == "user":
+        rows.append(("expected broken per hour at the throughput given "
+                     f"({fmt(s['throughput_per_hour'])}/h), 1/h",
+                     fmt(s["broken_per_hour_at_throughput"])))
+    rows += [
+        ("share of the hazard from the inner surface", fmt(s["inner_share"])),
+        ("impacts on walls and gate in the window", fmt(s["n_wall_events_window"])),
+        ("share of the hazard from wall and gate impacts", fmt(s["wall_share"])),
+        *((f"share of the hazard from the {name}", fmt(v))
+          for name, v in sorted(s.get("wall_share_by_wall", {}).items(), key=lambda kv: -kv[1])),
+        ("largest peak contact force in the window, N", fmt(s["max_force_N"])),
+        ("largest inner σ1 in the window, MPa", fmt((s["max_sigma_inner_Pa"] or 0) / 1e6)),
+        ("largest outer σ1 in the window, MPa", fmt((s["max_sigma_outer_Pa"] or 0) / 1e6)),
+    ]
+    parts.append(_table(rows, cls="summary"))
+    parts.append("<h2>Worst collisions</h2><p>An impact began at least at the minimum "
+                 "speed; a contact pressed by the queue began slower but the DEM pressed it to "
+                 "at least the force of an impact at that speed.</p>"
+                 "<table><tr><th>event</th><th>cartridge – partner</th><th>kind</th>"
                  "<th>time, s</th><th>x, y, m</th><th>v_n, m/s</th><th>F, N</th>"
                  "<th>σ1 inner, MPa</th><th>σ1 outer, MPa</th><th>P_k</th></tr>")
     for r in risk["worst_events"]:
         parts.append(f"<tr><td>{r['event']}</td><td>{r['i']} – {html.escape(r['with'])}</td>"
+                     f"<td>{html.escape(r.get('kind', 'impact'))}</td>"
                      f"<td>{r['time_s']:.4g}</td><td>{r['x_m']:.3f}, {r['y_m']:.3f}</td>"
                      f"<td>{r['normal_speed_m_per_s']:.3g}</td><td>{r['force_N']:.3g}</td>"
                      f"<td>{r['sigma_inner_Pa'] / 1e6:.3g}</td>"
@@ -116,6 +134,7 @@ def render_report(risk: dict[str, Any], figures: dict[str, bytes],
     parts.append(_table([(k, v if not isinstance(v, (dict, list)) else str(v))
                          for k, v in risk["settings_flat"].items()], ("setting", "value")))
     parts.append("<p>Files: risk.json (strict JSON), events.csv (one row per event), "
-                 "cartridges.csv (one row per cartridge), stages.json (stage record), "
+                 "passages.csv (one row per passage of a cartridge over the table), "
+                 "stages.json (stage record), "
                  "the figures as PNG.</p></body></html>")
     return "\n".join(parts)

@@ -1,5 +1,5 @@
 """The risk stage's products: ``risk.json`` (strict JSON), ``events.csv``,
-``cartridges.csv`` and ``risk_arrays.npz`` (the arrays the figures are drawn from), with the
+``passages.csv`` and ``risk_arrays.npz`` (the arrays the figures are drawn from), with the
 statement of what each number rests on (``basis``) and the warnings of the report."""
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from typing import Any, Optional
 
 import numpy as np
 
-from demfem.assess.risk_stage import (cartridge_risk, event_hazard, event_probabilities,
+from demfem.assess.risk_stage import (event_hazard, event_probabilities, passage_risk,
                                       risk_map, steady_state, worst_events)
 
 __all__ = ["risk_document", "VTK_EVENTS"]
@@ -20,13 +20,13 @@ VTK_EVENTS = 20_000
 
 
 def _write_vtk(out: Path, run, events: np.ndarray, p: dict[str, np.ndarray],
-               stress: dict[str, np.ndarray], cr: dict[str, Any],
+               stress: dict[str, np.ndarray], passages: np.ndarray, pr: dict[str, Any],
                inside: np.ndarray) -> list[Path]:
     """``events.vtp``: the window's :data:`VTK_EVENTS` events with the largest P_k at their
     contact points (m), with P_k, force (N), σ1 inner and outer (Pa), time (s), partner
     (0 cartridge, 1 wall) and the cartridge; ``cartridges.vtp``: every cartridge at its last
-    position on the table (m) with its P per passage, P over the window, events and hazard
-    rate (1/s). For ParaView (Glyph or Point Gaussian)."""
+    position on the table (m) with its last passage's P over the window, events and hazard.
+    For ParaView (Glyph or Point Gaussian)."""
     from demfem.io.vtk import write_vtp
 
     idx = np.flatnonzero(inside)
@@ -45,12 +45,16 @@ def _write_vtk(out: Path, run, events: np.ndarray, p: dict[str, np.ndarray],
     last = np.where(finite.any(axis=0), pos.shape[0] - 1 - np.argmax(finite[::-1], axis=0), -1)
     seen = last >= 0
     where = pos[last[seen], np.flatnonzero(seen)]
+    # each sphere's last passage (the table is sorted by sphere id, then start)
+    latest = np.full(run.n_particles, -1, np.int64)
+    latest[passages["particle"]] = np.arange(len(passages))
+    k = latest[seen]
     files.append(write_vtp(out / "cartridges.vtp", where, {
         "cartridge": np.flatnonzero(seen).astype(np.int64),
         "radius": np.asarray(run.radii, float)[seen],
-        "p_passage": cr["p_passage"][seen], "p_window": cr["p_window"][seen],
-        "n_events": np.asarray(cr["n_events"], np.int64)[seen],
-        "hazard_per_s": cr["hazard_per_s"][seen]}))
+        "passage": k, "p_window": pr["p_window"][k],
+        "n_events": np.asarray(pr["n_events"], np.int64)[k],
+        "hazard": pr["hazard"][k]}))
     return files
 
 
@@ -117,21 +121,35 @@ def _basis(model, scg, ev_summary: dict[str, Any], e_stress: float, table,
     return lines
 
 
+def _write_passages_csv(path: Path, run, table: np.ndarray, pr: dict[str, Any]) -> Path:
+    """``passages.csv``: one row per passage (a cartridge from insertion to exit)."""
+    from demfem.io.atomic import write_text_atomic
+
+    rows = ["passage,cartridge,tag,start_s,end_s,exited,exposure_in_window_s,"
+            "n_events_window,p_window,hazard"]
+    for k, ps in enumerate(table):
+        i = int(ps["particle"])
+        end = "" if not ps["exited"] else f"{ps['end']:.9g}"
+        rows.append(f"{k},{i},{int(run.tags[i])},{ps['start']:.9g},{end},"
+                    f"{int(ps['exited'])},{pr['exposure_s'][k]:.9g},{int(pr['n_events'][k])},"
+                    f"{pr['p_window'][k]:.9g},{pr['hazard'][k]:.9g}")
+    return write_text_atomic(path, "\n".join(rows) + "\n")
+
+
 def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[str, Any],
                   stress: dict[str, np.ndarray], model, scg, window: tuple[float, float],
-                  throughput: float, settings: dict[str, Any],
+                  throughput: Optional[float], settings: dict[str, Any],
                   e_stress: float) -> list[Path]:
     """Compute the risk stage and write its files into ``out``; returns their paths."""
     from demfem.assess.events import write_events_csv
-    from demfem.assess.run import _flatten, _save_npz
-    from demfem.io.atomic import write_text_atomic
+    from demfem.assess.npz import flatten, save_npz
     from demfem.io.strict_json import write_json_atomic
     from demfem.materials import PAPER_GLASS
     from demfem.risk import INNER_SURFACE, OUTER_SURFACE
 
     p = event_probabilities(stress, INNER_SURFACE, OUTER_SURFACE, scg)
-    n = run.n_particles
-    cr = cartridge_risk(events, p["p_event"], n, run.removal_times, window, throughput)
+    passages = run.passages()
+    pr = passage_risk(events, p["p_event"], passages, window, throughput)
     rule = settings.get("until_steady") or {}
     period = rule.get("period") or (float(table.gate_period) if table.gate_amplitude > 0
                                     else None)
@@ -152,8 +170,7 @@ def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[st
     by_wall = {name: float(hazard[inside & (events["wall"] == k)].sum()) / h_all
                for k, name in enumerate(wall_names)
                if h_all > 0 and np.any(inside & (events["wall"] == k))}
-    present = cr["exposure_s"] > 0
-    w = cr["window_s"]
+    w = pr["window_s"]
 
     def mx(a: np.ndarray) -> Optional[float]:
         return float(np.max(a)) if a.size else None
@@ -161,13 +178,19 @@ def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[st
     summary = {
         "n_events_window": int(inside.sum()),
         "event_rate_per_s": float(inside.sum() / w) if w > 0 else math.nan,
-        "mean_on_table": cr["mean_on_table"], "residence_time_s": cr["residence_time_s"],
-        "p_window_mean": float(np.mean(cr["p_window"][present])) if present.any() else 0.0,
-        "p_window_max": float(np.max(cr["p_window"])),
-        "p_passage_mean": float(np.mean(cr["p_passage"][present])) if present.any() else 0.0,
-        "p_passage_max": float(np.max(cr["p_passage"])),
-        "throughput_per_hour": throughput, "broken_per_hour": cr["broken_per_hour"],
-        "broken_per_hour_small_p": cr["broken_per_hour_small_p"],
+        "mean_on_table": pr["mean_on_table"], "exits_window": pr["exits"],
+        "discharge_per_hour": pr["discharge_per_hour"],
+        "residence_time_s": pr["residence_time_s"],
+        "passages_in_window": pr["passages_in_window"],
+        "p_passage": pr["p_passage"],
+        "p_window_max": mx(pr["p_window"]),
+        "throughput_per_hour": pr["throughput_per_hour"],
+        "throughput_source": pr["throughput_source"],
+        "broken_per_hour": pr["broken_per_hour"],
+        "broken_per_hour_table": pr["broken_per_hour_table"],
+        "broken_per_hour_small_p": pr["broken_per_hour_small_p"],
+        "broken_per_hour_at_throughput": pr["broken_per_hour_at_throughput"],
+        "unassigned_events": pr["unassigned_events"],
         "inner_share": h_in / (h_in + h_out) if h_in + h_out > 0 else math.nan,
         "n_wall_events_window": int(np.sum(inside & (events["partner"] == 1))),
         "wall_share": (float(hazard[inside & (events["partner"] == 1)].sum()) / h_all
@@ -200,17 +223,26 @@ def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[st
     if not table.refeed:
         warnings.append("The table is not re-fed: it drains as cartridges leave, so its "
                         "collision rate has no steady state (assess re-feeds by default).")
+    if pr["exits"] == 0:
+        warnings.append("No cartridge left the table in the statistics window: the table's "
+                        "own throughput is unknown"
+                        + (", the probability per passage uses the throughput given"
+                           if throughput is not None else
+                           "; give --throughput for a probability per passage") + ".")
     if w < 0.5:
         warnings.append(f"Short statistics window ({w:.3g} s, less than a quarter of the "
                         "gate period of the default table): a smoke run, not an assessment.")
-    doc = {"format": 1, "summary": summary, "steady_state": steady, "worst_events": worst,
+    doc = {"format": 2, "summary": summary, "steady_state": steady, "worst_events": worst,
            "events": ev_summary, "warnings": warnings,
            "basis": _basis(model, scg, ev_summary, e_stress, table, stress),
            "window_s": list(window), "settings": settings,
-           "settings_flat": {k: v for k, v in _flatten(settings).items()
+           "settings_flat": {k: v for k, v in flatten(settings).items()
                              if not k.startswith("stress_model.units")}}
     files = [write_json_atomic(out / "risk.json", doc)]
-    extra = {"force_N": stress["force_N"], "contact_radius_m": stress["contact_radius_m"],
+    extra = {"passage_i": pr["passage_i"], "passage_j": pr["passage_j"],
+             "pressed": events["pressed"],
+             "peak_tangential_force_N": events["peak_tangential_force"],
+             "force_N": stress["force_N"], "contact_radius_m": stress["contact_radius_m"],
              "duration_s": stress["duration_s"], "law_force_N": stress["law_force_N"],
              "sigma_inner_Pa": stress["sigma_inner_Pa"],
              "sigma_outer_Pa": stress["sigma_outer_Pa"],
@@ -219,17 +251,9 @@ def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[st
              "in_window": inside}
     write_events_csv(out / "events.csv", events, extra)
     files.append(out / "events.csv")
-    head = ("cartridge,tag,n_events_window,exposure_s,removal_time_s,p_window,"
-            "hazard_per_s,p_passage")
-    rows = [head]
-    for i in range(n):
-        rows.append(f"{i},{int(run.tags[i])},{int(cr['n_events'][i])},"
-                    f"{cr['exposure_s'][i]:.6g},{run.removal_times[i]:.6g},"
-                    f"{cr['p_window'][i]:.6g},{cr['hazard_per_s'][i]:.6g},"
-                    f"{cr['p_passage'][i]:.6g}")
-    files.append(write_text_atomic(out / "cartridges.csv", "\n".join(rows) + "\n"))
-    files += _write_vtk(out, run, events, p, stress, cr, inside)
-    files.append(_save_npz(out / "risk_arrays.npz", p_passage=cr["p_passage"],
-                           p_window=cr["p_window"], p_event=p["p_event"],
-                           **{f"map_{k}": v for k, v in rmap.items()}))
+    files.append(_write_passages_csv(out / "passages.csv", run, passages, pr))
+    files += _write_vtk(out, run, events, p, stress, passages, pr, inside)
+    files.append(save_npz(out / "risk_arrays.npz", p_window=pr["p_window"],
+                          p_event=p["p_event"],
+                          **{f"map_{k}": v for k, v in rmap.items()}))
     return files

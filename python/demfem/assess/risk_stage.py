@@ -13,22 +13,17 @@ time t_ref, σ_eq = σ_p [(τ/t_ref) Γ((n+1)/2)/(√π Γ(n/2+1))]^{1/n}
 one of its two cartridges with P_k = 1 − (1 − P_k,inner)(1 − P_k,outer); both partners of a
 sphere–sphere collision take the same load and each gets its own P_k (independent glass).
 
-Over the statistics window [t_0, T] (W = T − t_0), cartridge i with events k survives with
-Π(1 − P_k): P_window,i = 1 − Π(1 − P_k) (:func:`demfem.risk.cartridge_failure_probability`).
-
-From the window to an hour of production. Cartridge i was on the table for the exposure
-e_i = min(T, t_removed,i) − t_0 of the window, so its breakage hazard rate is
-λ_i = −ln(1 − P_window,i) / e_i (1/s). A cartridge's passage over the table lasts the
-residence time, by Little's law T_res = N̄ / Q with N̄ = Σ e_i / W the mean number of cartridges
-on the table in the window and Q the throughput (cartridges/s). Then
-
-    P_passage,i = 1 − exp(−λ_i T_res),   broken per hour = Q_h × mean_i P_passage,i
-
-(:func:`demfem.risk.expected_broken_per_hour`, Q_h = cartridges per hour). For small P this is
-3600 Σ_i λ_i: the rate at which the table's population breaks, independent of Q, as long as the
-table holds the simulated population at that throughput — which is the planning assumption.
-The assumption that the simulated window is representative of the table in production (a
-steady state) is checked by :func:`steady_state`.
+The unit of risk is a passage: one cartridge from its insertion on the table to its exit
+(:mod:`demfem.assess.passages`; a re-fed sphere id carries several). Over the statistics
+window [t_0, T] (W = T − t_0), passage p with events k survives with Π(1 − P_k):
+P_window,p = 1 − Π(1 − P_k). The table breaks Σ_p P_window,p / W cartridges per second; that
+times 3600 is the hourly number, the same whichever way it is summed (per event for small P:
+3600 Σ h_k / W, h_k = −ln(1 − P_k) per loaded cartridge). The probability that one passage
+breaks is that rate over the table's own discharge (exits / W) — or over a throughput the
+user names, when the window has no exits. A user's throughput Q different from the table's
+gives Q × P_passage per hour beside the table's own figure: it assumes the table in
+production looks like the simulated one, which the discharge rate shown beside it lets the
+user judge. The steady state of the window is checked by :func:`steady_state`.
 
 SI units: Pa, m², s; rates per second unless named per hour.
 """
@@ -39,20 +34,14 @@ from typing import Any, Optional, Sequence
 
 import numpy as np
 
-from demfem.errors import check_positive, check_range
+from demfem.errors import InvalidParameterError, check_positive, check_range
 from demfem.risk import (INNER_SURFACE, OUTER_SURFACE, SCG_BOROSILICATE, SlowCrackGrowth,
-                         SurfaceStrength, cartridge_failure_probability,
-                         expected_broken_per_hour)
+                         SurfaceStrength)
 from demfem.risk.fatigue import half_sine_sn_factor
 
-__all__ = ["DEFAULT_THROUGHPUT", "event_probabilities", "surface_probability",
-           "equivalent_stress", "cartridge_risk", "event_hazard", "steady_state",
+__all__ = ["event_probabilities", "surface_probability",
+           "equivalent_stress", "passage_risk", "event_hazard", "steady_state",
            "worst_events", "risk_map"]
-
-#: Default throughput of the filling line, cartridges per hour: a planning assumption
-#: (6000/h = 100 per minute, a mid-range filling line), not a property of the table.
-DEFAULT_THROUGHPUT = 6000.0
-
 
 def surface_probability(surface: SurfaceStrength, stress: np.ndarray,
                         area: np.ndarray) -> np.ndarray:
@@ -61,6 +50,12 @@ def surface_probability(surface: SurfaceStrength, stress: np.ndarray,
     exact down to P ~ 1e-300). ``stress`` in Pa, ``area`` in m², shape (n,)."""
     s = np.asarray(stress, float)
     a = np.asarray(area, float)
+    if np.any(np.isnan(s)) or np.any(np.isinf(s)):
+        raise InvalidParameterError("invalid stress: every value must be a finite number of "
+                                    "Pa (NaN or infinite found)")
+    if np.any(~np.isfinite(a)) or np.any(a < 0):
+        raise InvalidParameterError("invalid area: every value must be a finite number of m² "
+                                    ">= 0")
     out = np.zeros(np.broadcast(s, a).shape)
     on = (s > 0) & (a > 0)
     log_r = (np.log(a[on] / surface.reference_area)
@@ -98,55 +93,77 @@ def event_probabilities(stress: dict[str, np.ndarray], inner: SurfaceStrength = 
             "sigma_eq_inner_Pa": s_in, "sigma_eq_outer_Pa": s_out}
 
 
-def cartridge_risk(events: np.ndarray, p_event: np.ndarray, n: int, removal_times: np.ndarray,
-                   window: tuple[float, float], throughput_per_hour: float) -> dict[str, Any]:
-    """Per-cartridge probabilities over the window and per passage, and the hourly rate.
+def passage_risk(events: np.ndarray, p_event: np.ndarray, table: np.ndarray,
+                 window: tuple[float, float],
+                 throughput_per_hour: Optional[float] = None) -> dict[str, Any]:
+    """Per-passage probabilities over the window, and the hourly rate.
 
     Args:
         events: the event table (:data:`demfem.assess.events.EVENT_DTYPE`).
         p_event: (n_events,) P_k.
-        n: number of cartridges (sphere ids 0..n-1).
-        removal_times: (n,) time each left through the opening, s (NaN: stayed).
+        table: the run's passages (:func:`demfem.assess.passages.passages`).
         window: (t_0, T), s.
-        throughput_per_hour: cartridges per hour, > 0.
+        throughput_per_hour: cartridges per hour the user's line runs at (> 0), or None for
+            the table's own discharge in the window.
+
+    Every hourly figure is one number: the expected broken cartridges per second of the
+    table, Σ_p P_window,p / W over the passages p on it in the window (W = T − t_0), times
+    3600 (``broken_per_hour_table``); for small P it equals 3600 Σ_k h_k / W with
+    h_k = −ln(1 − P_k) per loaded cartridge (``broken_per_hour_small_p``). The probability
+    that one passage breaks is that rate over the discharge: ``p_passage`` =
+    broken per hour / passages per hour (the table's own, or the user's throughput where the
+    window has no exits). At a user's throughput the hourly number is ``p_passage`` times it
+    (``broken_per_hour_at_throughput``); ``broken_per_hour`` is that when a throughput is
+    given, else the table's own.
 
     Returns:
-        ``p_window`` (n,), ``exposure_s`` (n,), ``hazard_per_s`` (n,), ``p_passage`` (n,),
-        ``n_events`` (n,) in the window, and the scalars ``mean_on_table``, ``residence_time_s``,
-        ``broken_per_hour``, ``broken_per_hour_small_p`` (3600 Σ λ_i), ``window_s``.
+        per passage: ``p_window``, ``exposure_s``, ``n_events``, ``hazard``
+        (Σ −ln(1 − P_k) of its events); per event: ``passage_i``, ``passage_j`` (−1: a wall or
+        outside the window); and the scalars of :func:`demfem.assess.passages.table_flow`
+        with ``broken_per_hour_table``, ``broken_per_hour_small_p``, ``p_passage``,
+        ``broken_per_hour_at_throughput``, ``broken_per_hour``, ``throughput_per_hour``,
+        ``throughput_source`` and ``unassigned_events`` (a cartridge partner on no
+        passage: 0 in a consistent run).
     """
-    q = check_positive("throughput_per_hour", throughput_per_hour)
+    from demfem.assess.passages import passage_of_events, table_flow
+
+    q_user = (None if throughput_per_hour is None
+              else check_positive("throughput_per_hour", throughput_per_hour))
+    flow = table_flow(table, window)
     t0, t1 = window
-    w = t1 - t0
+    w = flow["window_s"]
     inside = (events["time"] >= t0) & (events["time"] <= t1)
     p_in = np.asarray(p_event, float)
-    log_surv = np.zeros(n)
-    counts = np.zeros(n, np.int64)
     neg_log = np.log1p(-np.where(inside, p_in, 0.0))
+    m = len(table)
+    log_surv = np.zeros(m)
+    counts = np.zeros(m, np.int64)
+    out_pass = {}
+    unassigned = 0
     for col in ("i", "j"):
-        idx = np.asarray(events[col], np.int64)
-        ok = inside & (idx >= 0)
-        np.add.at(log_surv, idx[ok], neg_log[ok])
-        np.add.at(counts, idx[ok], 1)
-    # P_window,i = 1 - prod(1 - P_k) over each cartridge's own events (demfem.risk)
-    from demfem.assess.events import events_per_cartridge
-
-    lists = events_per_cartridge(events[inside], n)
-    p_win_events = p_in[inside]
-    p_window = np.array([cartridge_failure_probability(p_win_events[ix]) for ix in lists])
-    end = np.where(np.isfinite(removal_times), np.minimum(removal_times, t1), t1)
-    exposure = np.clip(end - t0, 0.0, w)
-    hazard = np.where(exposure > 0, -log_surv / np.where(exposure > 0, exposure, 1.0), 0.0)
-    mean_on = float(exposure.sum() / w) if w > 0 else 0.0
-    t_res = mean_on / (q / 3600.0)
-    p_passage = -np.expm1(-hazard * t_res)
-    present = exposure > 0
-    return {"p_window": p_window, "exposure_s": exposure, "hazard_per_s": hazard,
-            "p_passage": p_passage, "n_events": counts, "mean_on_table": mean_on,
-            "residence_time_s": t_res, "window_s": w,
-            "broken_per_hour": expected_broken_per_hour(p_passage[present], q),
-            "broken_per_hour_small_p": 3600.0 * float(hazard[present].sum())
-            if mean_on > 0 else 0.0}
+        who = np.asarray(events[col], np.int64)
+        k = passage_of_events(table, who, events["time"])
+        ok = inside & (k >= 0)
+        unassigned += int(np.sum(inside & (who >= 0) & (k < 0)))
+        np.add.at(log_surv, k[ok], neg_log[ok])
+        np.add.at(counts, k[ok], 1)
+        out_pass[f"passage_{col}"] = np.where(inside, k, -1)
+    p_window = -np.expm1(log_surv)
+    per_s = float(p_window.sum() / w)
+    q_table = flow["discharge_per_hour"]
+    q = q_table if q_table > 0 else q_user
+    p_passage = 3600.0 * per_s / q if q else math.nan
+    at_user = p_passage * q_user if q_user is not None else math.nan
+    return {**out_pass, "p_window": p_window, "exposure_s": flow["exposure_s"],
+            "n_events": counts, "hazard": -log_surv,
+            **{k: v for k, v in flow.items() if k != "exposure_s"},
+            "broken_per_hour_table": 3600.0 * per_s,
+            "broken_per_hour_small_p": 3600.0 * float(-log_surv.sum()) / w,
+            "p_passage": p_passage, "broken_per_hour_at_throughput": at_user,
+            "broken_per_hour": at_user if q_user is not None else 3600.0 * per_s,
+            "throughput_per_hour": q_user if q_user is not None else q_table,
+            "throughput_source": "user" if q_user is not None else "table",
+            "unassigned_events": unassigned}
 
 
 def event_hazard(events: np.ndarray, p: np.ndarray) -> np.ndarray:
@@ -222,6 +239,8 @@ def worst_events(events: np.ndarray, p: dict[str, np.ndarray], stress: dict[str,
                      "time_s": float(e["time"]),
                      "x_m": float(e["x"]), "y_m": float(e["y"]),
                      "normal_speed_m_per_s": float(e["normal_speed"]),
+                     "kind": "pressed by the queue" if bool(e["pressed"]) else "impact",
+                     "tangential_force_N": float(e["peak_tangential_force"]),
                      "force_N": float(stress["force_N"][k]),
                      "sigma_inner_Pa": float(stress["sigma_inner_Pa"][k]),
                      "sigma_outer_Pa": float(stress["sigma_outer_Pa"][k]),

@@ -8,7 +8,7 @@ per cartridge, in six resumable stages (:data:`demfem.assess.stages.STAGES`):
 3. **events** — impact events above the minimum speed (``events.npz``);
 4. **stress** — force, duration, σ1 and stressed area per event (``stress.npz``);
 5. **risk** — P per event, per cartridge and per hour, steady state, worst events, risk map
-   (``risk.json``, ``events.csv``, ``cartridges.csv``, ``risk_arrays.npz``);
+   (``risk.json``, ``events.csv``, ``passages.csv``, ``risk_arrays.npz``);
 6. **report** — ``report.html`` and the figures.
 
 SI units throughout: m, s, kg, N, Pa.
@@ -24,7 +24,7 @@ from typing import Any, Callable, Optional
 import numpy as np
 
 from demfem.assess.events import DEFAULT_MIN_SPEED
-from demfem.assess.risk_stage import DEFAULT_THROUGHPUT
+from demfem.assess.npz import load_npz, save_npz
 from demfem.assess.stages import STAGES, StageBook
 from demfem.assess.stress_model import StressModel
 from demfem.errors import InvalidParameterError, check_positive, check_range
@@ -58,32 +58,8 @@ def steady_rule(table, full: bool = False, min_speed: float = DEFAULT_MIN_SPEED)
 
 #: Files the job writes (removed by a fresh start), besides the DEM checkpoint.
 OUTPUT_FILES = ("calibration.json", "table_run.npz", "events.npz", "stress.npz", "risk.json",
-                "events.csv", "cartridges.csv", "events.vtp", "cartridges.vtp",
+                "events.csv", "passages.csv", "events.vtp", "cartridges.vtp",
                 "risk_arrays.npz", "report.html")
-
-
-def _save_npz(path: Path, **arrays: Any) -> Path:
-    from demfem.io.atomic import atomic_path
-
-    with atomic_path(path, suffix=".npz") as tmp:
-        with open(tmp, "wb") as fh:
-            np.savez(fh, **arrays)
-    return path
-
-
-def _load_npz(path: Path) -> dict[str, np.ndarray]:
-    with np.load(path, allow_pickle=False) as data:
-        return {k: data[k] for k in data.files}
-
-
-def _flatten(d: dict[str, Any], prefix: str = "") -> dict[str, Any]:
-    out: dict[str, Any] = {}
-    for k, v in d.items():
-        if isinstance(v, dict):
-            out.update(_flatten(v, f"{prefix}{k}."))
-        else:
-            out[f"{prefix}{k}"] = v
-    return out
 
 
 def _event_min_force(table, e_stress: float, v_min: float) -> float:
@@ -100,7 +76,7 @@ def _event_min_force(table, e_stress: float, v_min: float) -> float:
 
 def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
            duration: Optional[float] = None, quick: bool = False, full: bool = False,
-           throughput: float = DEFAULT_THROUGHPUT, fresh: bool = False,
+           throughput: Optional[float] = None, fresh: bool = False,
            sample_interval: Optional[float] = None, min_speed: float = DEFAULT_MIN_SPEED,
            discard_before: Optional[float] = None, stress_model: Optional[StressModel] = None,
            stress_young_modulus: Optional[float] = None, slow_crack_growth: bool = True,
@@ -119,7 +95,8 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
         quick: a smoke run (0.1 s simulated).
         full: the full-accuracy run: until four gate periods agree within 10 % (the default:
             two within 15 %).
-        throughput: cartridges per hour through the table, > 0 (a planning assumption).
+        throughput: cartridges per hour of the user's line, > 0; None (default): the table's
+            own discharge in the simulation. Given, the report shows both.
         fresh: replace an assessment with other settings in ``out`` instead of refusing it.
         sample_interval: time between recorded samples, s (default 0.02; quick 0.01).
         min_speed: minimum normal impact speed of an event, m/s (≥ 0).
@@ -152,7 +129,7 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
             duration, (int, float)) and math.isfinite(duration) and duration > 0 else 0.02
     check_run_arguments(duration, sample_interval, threads)
     duration = float(duration)
-    q = check_positive("throughput", throughput)
+    q = None if throughput is None else check_positive("throughput", throughput)
     v_min = check_range("min_speed", min_speed, 0.0, math.inf, lo_open=False)
     if until_steady and discard_before is not None:
         raise InvalidParameterError(
@@ -262,7 +239,9 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
     else:
         run = TableRun.load(run_path)
     log(f"  {run.info['steps']} steps of {run.info['dt']:.3g} s, "
-        f"{len(run.onsets)} contact onsets, wall {run.info['wall_time_s']:.1f} s")
+        f"{len(run.onsets) + len(run.wall_onsets)} contact onsets ({len(run.onsets)} between "
+        f"cartridges, {len(run.wall_onsets)} with walls, gate and belt), wall "
+        f"{run.info['wall_time_s']:.1f} s")
     end = float(run.info["duration"])
     if rule is not None:
         # the statistics window: every whole period since the warm-up
@@ -275,21 +254,19 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
         return {"stopped_after": "dem"}
 
     # 3. events
-    from demfem.assess.events import EVENT_DTYPE, impact_events
+    from demfem.assess.events import EVENT_DTYPE, count_line, impact_events
 
     ev_path = out / "events.npz"
     done = book.is_done("events")
     header(3, f"impact events (normal speed >= {v_min:g} m/s)", done)
     if not done:
         events, ev_summary = impact_events(run, v_min, _event_min_force(table, e_stress, v_min))
-        _save_npz(ev_path, events=events, summary=np.array(json.dumps(ev_summary)))
+        save_npz(ev_path, events=events, summary=np.array(json.dumps(ev_summary)))
         book.complete("events", [ev_path])
-    data = _load_npz(ev_path)
+    data = load_npz(ev_path)
     events = data["events"].astype(EVENT_DTYPE)
     ev_summary = json.loads(str(data["summary"]))
-    log(f"  {ev_summary['n_events']} events ({ev_summary.get('n_wall_events', 0)} on walls "
-        f"and the gate) of {ev_summary['n_onsets']} onsets ({ev_summary['n_dropped']} below "
-        f"{v_min:g} m/s dropped)")
+    log("  " + count_line(ev_summary))
     if stop_after == "events":
         return {"stopped_after": "events"}
 
@@ -311,9 +288,9 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
             events["normal_speed"], events["partner"], model, e_stress, table.poisson_ratio,
             measured_force=events["peak_force"] if use_measured else None,
             measured_impulse=events["impulse"] if use_measured else None)
-        _save_npz(st_path, **stress)
+        save_npz(st_path, **stress)
         book.complete("stress", [st_path])
-    stress = _load_npz(st_path)
+    stress = load_npz(st_path)
     if len(events):
         log(f"  peak force up to {stress['force_N'].max():.3g} N, inner sigma1 up to "
             f"{stress['sigma_inner_Pa'].max() / 1e6:.3g} MPa")
@@ -321,6 +298,7 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
         return {"stopped_after": "stress"}
 
     # 5. risk
+    from demfem.assess.headline import headline
     from demfem.assess.risk_product import risk_document
 
     done = book.is_done("risk")
@@ -331,8 +309,7 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
         book.complete("risk", files)
     risk = json.loads((out / "risk.json").read_text(encoding="utf-8"))
     s = risk["summary"]
-    log(f"  P per passage: mean {s['p_passage_mean']:.3g}, max {s['p_passage_max']:.3g}; "
-        f"expected broken per hour at {q:g}/h: {s['broken_per_hour']:.3g}")
+    log("  " + headline(s))
     if stop_after == "risk":
         return risk
 
@@ -344,17 +321,17 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
     done = book.is_done("report")
     header(6, "report.html", done)
     if not done:
-        arrays = _load_npz(out / "risk_arrays.npz")
+        arrays = load_npz(out / "risk_arrays.npz")
         figs = make_figures(out, {
             "map": {k: arrays[f"map_{k}"] for k in ("hazard", "count", "x_edges", "y_edges")},
             "onset_speeds": run.onsets["normal_speed"], "events": events,
             "window": (t0, end), "min_speed": v_min, "stress": stress, "model": model,
-            "p_passage": arrays["p_passage"], "steady": risk["steady_state"],
+            "p_window": arrays["p_window"], "steady": risk["steady_state"],
             "duration": end})
         html_path = write_text_atomic(out / "report.html",
                                       render_report(risk, figs, figures_names))
         book.complete("report", [html_path, *(out / n for n in figs)])
-    log(f"  written to {out}: report.html, risk.json, events.csv, cartridges.csv, "
+    log(f"  written to {out}: report.html, risk.json, events.csv, passages.csv, "
         "events.vtp, cartridges.vtp (ParaView), "
         + ", ".join(figures_names))
     return risk

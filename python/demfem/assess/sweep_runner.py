@@ -9,7 +9,7 @@ Each point is the built-in default table with the grid's fields replaced (any
 :class:`~demfem.scenes.table.AccumulationTable` field, SI units), run by
 :func:`demfem.assess.assess` for ``duration`` s (a grid or a fixed parameter; default: as
 ``demfem assess``, re-fed until the collision rate is steady)
-at ``throughput`` cartridges per hour (default 6000). The assessment's folder is
+at ``throughput`` cartridges per hour (default: the table's own discharge). The assessment's folder is
 ``run_dir/<key>`` when ``run_dir`` is given (kept, resumable), else a temporary folder
 that is removed. Returns the risk summary's numbers, each key naming its unit.
 """
@@ -24,7 +24,7 @@ from typing import Any
 __all__ = ["risk_point"]
 
 #: Summary numbers a risk sweep returns.
-_KEYS = ("broken_per_hour", "p_passage_mean", "p_passage_max", "n_events_window",
+_KEYS = ("broken_per_hour", "p_passage", "discharge_per_hour", "n_events_window",
          "n_wall_events_window", "wall_share", "max_force_N", "max_sigma_inner_Pa",
          "max_sigma_outer_Pa", "event_rate_per_s")
 
@@ -40,7 +40,8 @@ def risk_point(params: dict) -> dict:
     p = dict(params)
     raw = p.pop("duration", None)
     duration = None if raw is None else float(raw)
-    throughput = float(p.pop("throughput", 6000.0))
+    raw_q = p.pop("throughput", None)
+    throughput = None if raw_q is None else float(raw_q)
     run_dir = p.pop("run_dir", None)
     fields = {f.name for f in dataclasses.fields(AccumulationTable)}
     unknown = sorted(set(p) - fields)

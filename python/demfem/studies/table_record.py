@@ -34,6 +34,28 @@ class Recorder:
         self.wall_parts: list[dict[str, np.ndarray]] = []
         self.event_parts: list[dict[str, np.ndarray]] = []
         self.removal_times = np.full(n, np.nan)
+        # every exit and every re-insertion, (time s, sphere id): the passages
+        # (demfem.assess.passages); the engine's removal list restarts empty after a resume
+        self.removal_log: list[np.ndarray] = []
+        self.insertion_log: list[np.ndarray] = []
+        self._removals_seen = 0
+
+    def note_insertions(self, time: float, index: np.ndarray) -> None:
+        """Record that spheres ``index`` were put back on the table at ``time`` (s)."""
+        index = np.asarray(index, np.int64)
+        if index.size:
+            self.insertion_log.append(np.column_stack([np.full(index.size, float(time)),
+                                                       index.astype(float)]))
+
+    def logs(self) -> dict[str, np.ndarray]:
+        """The removal and insertion logs as arrays: ``removal_log_time`` (s),
+        ``removal_log_index``, ``insertion_log_time`` (s), ``insertion_log_index``."""
+        out = {}
+        for name, parts in (("removal", self.removal_log), ("insertion", self.insertion_log)):
+            a = np.concatenate(parts) if parts else np.zeros((0, 2))
+            out[f"{name}_log_time"] = a[:, 0].copy()
+            out[f"{name}_log_index"] = a[:, 1].astype(np.int64)
+        return out
 
     def sample(self, sim, table: AccumulationTable) -> None:
         alive = np.asarray(sim.alive(), bool)
@@ -79,8 +101,13 @@ class Recorder:
         sim.clear_records()
         times, index = sim.removals()
         index = np.asarray(index, np.int64)
+        times = np.asarray(times, float)
         new = np.isnan(self.removal_times[index])
-        self.removal_times[index[new]] = np.asarray(times, float)[new]
+        self.removal_times[index[new]] = times[new]
+        fresh = slice(self._removals_seen, None)
+        if index[fresh].size:
+            self.removal_log.append(np.column_stack([times[fresh], index[fresh].astype(float)]))
+        self._removals_seen = int(index.size)
 
     def impact_times(self, rule) -> np.ndarray:
         """Times (s) of the recorded onsets that ``rule`` (a
@@ -159,6 +186,7 @@ class Recorder:
         arrays.update({f"onset_{k}": v for k, v in self.raw_onsets().items()})
         arrays.update({f"wall_onset_{k}": v for k, v in self.raw_onsets(walls=True).items()})
         arrays["removal_times"] = self.removal_times
+        arrays.update(self.logs())
         with atomic_path(path, suffix=".npz") as tmp:
             with open(tmp, "wb") as fh:
                 np.savez(fh, **arrays)
@@ -176,6 +204,13 @@ class Recorder:
             if "event_time" in data.files:
                 self.event_parts = [{k: data[f"event_{k}"] for k in _EVENT_COLUMNS}]
             self.removal_times = np.array(data["removal_times"], float)
+            self._removals_seen = 0  # the restored engine's removal list starts empty
+            self.removal_log, self.insertion_log = [], []
+            for name in ("removal", "insertion"):
+                if f"{name}_log_time" in data.files:
+                    log = np.column_stack([np.array(data[f"{name}_log_time"], float),
+                                           np.array(data[f"{name}_log_index"], float)])
+                    getattr(self, f"{name}_log").append(log)
 
 
 #: The engine's event columns (:meth:`demfem._core.DemSimulation.events`).

@@ -20,6 +20,8 @@ import json
 import math
 import os
 import time as _time
+import zipfile
+import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Mapping, Optional
@@ -34,6 +36,8 @@ from demfem.errors import (CheckpointError, DemfemIOError, InvalidParameterError
                            SettingsMismatchError)
 from demfem.io.atomic import atomic_path
 from demfem.io.strict_json import dumps as json_dumps
+# the output-folder helpers live with the job runner; re-exported for existing callers
+from demfem.jobs.folder import settings_differences, sha256_file
 from demfem.progress import ProgressBar
 from demfem.scenes.table import AccumulationTable
 from demfem.studies.steady import SteadyRule
@@ -80,6 +84,10 @@ class TableRun:
             :data:`demfem.analysis.contact_events.CONTACT_EVENT_DTYPE`; recorded when the run
             asks (``run_table(record_events=True)``, ``info["events_recorded"]``), else empty.
             Contacts still open at the end are in it with ``complete`` False.
+        passage_log: every exit and re-insertion: ``removal_log_time`` (s),
+            ``removal_log_index``, ``insertion_log_time`` (s), ``insertion_log_index``
+            (:func:`demfem.assess.passages.passages`); empty for runs saved before it was
+            recorded (then only the first exit of each sphere is known, ``removal_times``).
     """
 
     parameters: dict[str, Any]
@@ -100,6 +108,22 @@ class TableRun:
     wall_onsets: np.ndarray = field(default_factory=lambda: np.zeros(0, WALL_ONSET_DTYPE))
     contact_events: np.ndarray = field(
         default_factory=lambda: np.zeros(0, CONTACT_EVENT_DTYPE))
+    passage_log: dict[str, np.ndarray] = field(default_factory=dict)
+
+    def passages(self) -> np.ndarray:
+        """The run's passages (:func:`demfem.assess.passages.passages`): each cartridge from
+        its insertion to its exit. A run saved without the passage log gives one passage per
+        sphere, ending at its first exit."""
+        from demfem.assess.passages import passages
+
+        log = self.passage_log
+        end = float(self.info.get("duration", self.times[-1] if len(self.times) else 0.0))
+        if log:
+            return passages(self.n_particles, log["removal_log_time"],
+                            log["removal_log_index"], log["insertion_log_time"],
+                            log["insertion_log_index"], end)
+        gone = np.flatnonzero(np.isfinite(self.removal_times))
+        return passages(self.n_particles, self.removal_times[gone], gone, end_time=end)
 
     @property
     def n_frames(self) -> int:
@@ -153,7 +177,8 @@ class TableRun:
         arrays = {name: getattr(self, name) for name in ARRAYS}
         arrays.update(tags=self.tags, radii=self.radii, removal_times=self.removal_times,
                       onsets=self.onsets, wall_onsets=self.wall_onsets,
-                      contact_events=self.contact_events)
+                      contact_events=self.contact_events,
+                      **{f"passage_{k}": v for k, v in self.passage_log.items()})
         document = json_dumps({"parameters": self.parameters, "info": self.info})
         target = Path(path)
         with atomic_path(target, suffix=".npz") as tmp:
@@ -169,8 +194,12 @@ class TableRun:
             with np.load(path, allow_pickle=False) as data:
                 document = json.loads(str(data["document"]))
                 arrays = {k: data[k] for k in data.files if k != "document"}
+                log = {k[len("passage_"):]: arrays.pop(k) for k in list(arrays)
+                       if k.startswith("passage_")}
         except OSError as exc:
             raise DemfemIOError(f"i/o error on {path}: {exc}") from None
+        except (zipfile.BadZipFile, EOFError, zlib.error) as exc:
+            raise CheckpointError(f"damaged table run file {path}: {exc}") from None
         except (KeyError, ValueError) as exc:
             raise InvalidParameterError(f"invalid table run file {path}: {exc}") from None
         missing = [k for k in (*ARRAYS, "tags", "radii", "removal_times", "onsets")
@@ -182,7 +211,8 @@ class TableRun:
             arrays["wall_onsets"] = np.zeros(0, WALL_ONSET_DTYPE)
         if "contact_events" not in arrays:  # a run saved before events were recorded
             arrays["contact_events"] = np.zeros(0, CONTACT_EVENT_DTYPE)
-        return cls(parameters=document["parameters"], info=document["info"], **arrays)
+        return cls(parameters=document["parameters"], info=document["info"], passage_log=log,
+                   **arrays)
 
     def summary(self, discard_before: float = 0.0, quantile: float = 0.95) -> dict[str, float]:
         """Numbers for a sweep table, each key naming its unit (SI; counts ``n_*`` and the
@@ -247,32 +277,6 @@ def run_settings(table: AccumulationTable, duration: float, sample_interval: flo
     if record_events:
         settings["record_events"] = True
     return finite_or_none(settings)
-
-
-def settings_differences(recorded: Mapping[str, Any], now: Mapping[str, Any],
-                         prefix: str = "") -> list[str]:
-    """``"name: <recorded> -> <now>"`` for each setting that differs (nested dicts by
-    dotted name)."""
-    out = []
-    for key in sorted(set(recorded) | set(now)):
-        a, b = recorded.get(key), now.get(key)
-        name = f"{prefix}{key}"
-        if isinstance(a, Mapping) and isinstance(b, Mapping):
-            out += settings_differences(a, b, name + ".")
-        elif a != b:
-            out.append(f"{name}: {a!r} -> {b!r}")
-    return out
-
-
-def sha256_file(path: Path) -> str:
-    """Hex SHA-256 of a file's bytes."""
-    import hashlib
-
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
 
 
 def run_table(table: AccumulationTable, duration: float, sample_interval: float = 0.05,
@@ -364,7 +368,10 @@ def run_table(table: AccumulationTable, duration: float, sample_interval: float 
         # Steps are whole: advance to the first step at or after the sample time.
         sim.run_until(float(sample_times[k]))
         if scene.refeed is not None:
+            off = ~np.asarray(sim.alive(), bool)
             refeed_removed(sim, scene.refeed["sites"], scene.refeed["velocity"])
+            rec.note_insertions(float(sim.time), np.flatnonzero(off & np.asarray(sim.alive(),
+                                                                                  bool)))
         rec.collect_events(sim, record_events, keep_events)
         rec.sample(sim, table)
         check_state(sim, floor=belt, overlap_fraction=overlap_fraction)
@@ -385,6 +392,7 @@ def run_table(table: AccumulationTable, duration: float, sample_interval: float 
         tags=np.asarray(scene.tags, np.int64),
         radii=np.asarray(scene.radii, float),
         removal_times=rec.removal_times,
+        passage_log=rec.logs(),
         onsets=rec.onset_table(frames["times"], frames["coordination"]),
         wall_onsets=rec.wall_onset_table(frames["times"], frames["coordination"]),
         contact_events=(rec.event_table(frames["times"], frames["coordination"],
