@@ -19,14 +19,15 @@ the ≈ 5 g of a real 3 mL cartridge, and the equivalent sphere (≈ 16.2 mm) wi
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields, replace
+from typing import Any, Mapping
 
 import numpy as np
 
 from demfem.errors import InvalidParameterError, check_positive, check_range
 from demfem.materials import PAPER_GLASS, Material
 
-__all__ = ["Cartridge", "EquivalentSphere", "BeadClump", "MassProperties"]
+__all__ = ["Cartridge", "EquivalentSphere", "BeadClump", "MassProperties", "CARTRIDGE_PRESETS"]
 
 # 3-point Gauss–Legendre on [0, 1]: exact for polynomials of degree <= 5. The integrands of
 # volume, first moment and inertia are polynomials of degree <= 4 in z on each segment
@@ -194,6 +195,42 @@ class Cartridge:
                    length=length, shoulder_length=0.0, neck_outer_diameter=outer_diameter,
                    neck_length=0.0, flange_outer_diameter=outer_diameter, flange_length=0.0,
                    flange_chamfer=0.0, material=material)
+
+    # ------------------------------------------------------------------ scene files
+    def geometry_dict(self) -> dict[str, float]:
+        """The dimensions (m) as a plain mapping: the ``[cartridge]`` table of a scene file."""
+        return {f.name: float(getattr(self, f.name)) for f in fields(self)
+                if f.name != "material"}
+
+    @classmethod
+    def from_geometry(cls, values: Any, material: Material = PAPER_GLASS,
+                      source: str = "scene") -> "Cartridge":
+        """A cartridge from a scene file's ``[cartridge]`` table: ``preset`` (one of
+        :data:`CARTRIDGE_PRESETS`; default ``"iso13926_3ml"``) and any dimension overriding
+        it (m), made of ``material``. Unknown keys and non-numbers are errors naming the key
+        and ``source``."""
+        if isinstance(values, Cartridge):
+            return replace(values, material=material)
+        if values is None:
+            values = {}
+        if not isinstance(values, Mapping):
+            raise InvalidParameterError(f"invalid [cartridge] in {source}: must be a table of "
+                                        "dimensions (m)")
+        values = dict(values)
+        values.pop("material", None)  # a saved document's copy; the scene's glass rules
+        preset = values.pop("preset", "iso13926_3ml")
+        if preset not in CARTRIDGE_PRESETS:
+            raise InvalidParameterError(f"invalid preset = {preset!r} in [cartridge] of {source}: "
+                                        f"must be one of {tuple(CARTRIDGE_PRESETS)}")
+        allowed = [f.name for f in fields(cls) if f.name != "material"]
+        for key, value in values.items():
+            if key not in allowed:
+                raise InvalidParameterError(f"unknown key {key!r} in [cartridge] of {source}; "
+                                            "allowed keys: preset, " + ", ".join(allowed))
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise InvalidParameterError(f"invalid {key} = {value!r} in [cartridge] of "
+                                            f"{source}: must be a number of metres")
+        return cls(**{**CARTRIDGE_PRESETS[preset], **values}, material=material)
 
     # ------------------------------------------------------------------ geometry
     @property
@@ -376,3 +413,14 @@ class Cartridge:
         c = np.vstack(centers)
         c[:, 2] -= self.center_of_mass[2]
         return BeadClump(centers=c, radii=np.concatenate(radii), masses=np.concatenate(masses))
+
+
+#: Named cartridge geometries for scene files (``[cartridge] preset = ...``), dimensions in m.
+#: ``iso13926_3ml``: the default 3 mL pen-injector cartridge of this module's text (body
+#: Ø 11.6 mm, wall 1.1 mm, 64 mm long; neck and flange representative of the class).
+#: ``tube``: the same body as a plain open tube of the same length (no shoulder, neck or
+#: flange), as the FEM verification cases use.
+CARTRIDGE_PRESETS: dict[str, dict[str, float]] = {
+    "iso13926_3ml": Cartridge().geometry_dict(),
+    "tube": Cartridge.tube(11.6e-3, 1.1e-3, 64.0e-3).geometry_dict(),
+}

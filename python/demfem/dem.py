@@ -220,7 +220,7 @@ def from_scene(
     (k_n, k_t) in N/m) or ``"fem_line"``: the linear law calibrated on the explicit FEM of two
     cartridges meeting side by side (:func:`demfem.fem.line_law.line_contact_stiffness`), for
     upright cartridges whose impacts are line contacts. The Reissner stiffness uses
-    ``shell_thickness`` and ``shell_radius`` (m; default: the default cartridge's wall
+    ``shell_thickness`` and ``shell_radius`` (m; default: the scene's cartridge's wall
     thickness and body mid-surface radius); walls do not bend (infinite shell stiffness).
     ``dt`` (s) defaults to ``dt_safety`` times the stable limit; a larger one is refused.
     Contact onsets are logged (``record_onsets``) because the FEM load cases come from them.
@@ -249,7 +249,7 @@ def from_scene(
             "the equivalent sphere has the cartridge's mass and material, so both must agree")
     k_r = float("inf")
     if model == "hertz_reissner_mindlin":
-        c = Cartridge()
+        c = Cartridge.from_geometry((getattr(scene, "parameters", None) or {}).get("cartridge"))
         t = c.wall_thickness if shell_thickness is None else shell_thickness
         r = c.body_mid_radius if shell_radius is None else shell_radius
         k_r = reissner_stiffness(pm["young_modulus"], pm["poisson_ratio"], t, r)

@@ -80,7 +80,7 @@ def from_scene(
     cartridge at the sphere's (x, y) with its bottom ``lift`` (m) above the belt.
 
     ``particle`` (``"clump"`` or ``"cylinder"``) defaults to the scene's own ``particle``
-    parameter. The cartridge (default :class:`demfem.cartridge.Cartridge`) must have the
+    parameter. The cartridge (default: the scene's ``[cartridge]``) must have the
     scene's particle mass at the scene's glass density, as the equivalent sphere does, so
     that spheres and full shapes carry the same mass. ``dt`` (s) defaults to the stable limit
     of the stiffest contact at ``expected_max_speed`` (m/s); a larger one is refused.
@@ -103,7 +103,8 @@ def from_scene(
         raise InvalidParameterError(
             "invalid refeed = True: the rigid engine removes cartridges through the outlet but "
             "cannot re-insert them; run with refeed = False")
-    c = Cartridge() if cartridge is None else cartridge
+    c = (Cartridge.from_geometry((getattr(scene, "parameters", None) or {}).get("cartridge"))
+         if cartridge is None else cartridge)
     pm = scene.materials[scene.particle_material]
     mass = pm["density"] * c.glass_volume
     masses = np.asarray(scene.masses, float)

@@ -26,7 +26,7 @@ import numpy as np
 from demfem.assess.events import DEFAULT_MIN_SPEED
 from demfem.assess.npz import load_npz, save_npz
 from demfem.assess.stages import STAGES, StageBook
-from demfem.assess.stress_model import StressModel
+from demfem.stress.stress_model import StressModel
 from demfem.errors import InvalidParameterError, check_positive, check_range
 
 __all__ = ["assess", "OUTPUT_FILES", "QUICK_DURATION", "DEFAULT_DURATION", "FULL_DURATION",
@@ -70,7 +70,7 @@ def _event_min_force(table, e_stress: float, v_min: float) -> float:
 
     if v_min <= 0:
         return 0.0
-    body = cartridge_body(e_stress, table.poisson_ratio)
+    body = cartridge_body(e_stress, table.poisson_ratio, table.cartridge)
     return float(ImpactLaw(body, body).force(np.array([v_min]))[0])
 
 
@@ -151,6 +151,9 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
             "the shell) does not describe; assess the table with 'hertz_reissner_mindlin' "
             "(or 'hertz_mindlin')")
     if refeed and not table.refeed:
+        log("note: the scene has refeed = false; assess re-feeds the cartridges that leave so "
+            "that the table stays in operation (refeed=False, demfem assess --no-refeed, runs "
+            "the scene as a draining batch)")
         table = dataclasses.replace(table, refeed=True)
     rule = steady_rule(table, full, v_min) if until_steady else None
     model = stress_model if stress_model is not None else StressModel.default()
@@ -191,7 +194,7 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
     if not done:
         from demfem.io.strict_json import write_json_atomic
 
-        body = cartridge_body(e_stress, table.poisson_ratio)
+        body = cartridge_body(e_stress, table.poisson_ratio, table.cartridge)
         law = ImpactLaw(body, body)
         speeds = [0.005, 0.01, 0.02, 0.05, 0.1, 0.2]
         cal = {"young_modulus_Pa": e_stress, "poisson_ratio": body.nu,
