@@ -264,7 +264,7 @@ def _cmd_assess(args: argparse.Namespace) -> int:
         model = StressModel.load(args.stress_model)
     result = assess(args.scene, out=args.out, duration=args.duration, quick=args.quick,
                     full=args.full, throughput=args.throughput, fresh=args.fresh,
-                    threads=args.threads, stress_model=model, refeed=not args.no_refeed,
+                    threads=args.threads, stress_model=model, refeed=not args.no_refeed, csv=args.csv,
                     progress=True, log=lambda line: print(line, flush=True))
     if "summary" in result:
         from demfem.assess.headline import headline
@@ -274,7 +274,7 @@ def _cmd_assess(args: argparse.Namespace) -> int:
 
 
 def _cmd_stress_model(args: argparse.Namespace) -> int:
-    from demfem.assess.fem_fit import DEFAULT_GRID, QUICK_GRID, fit_from_fem
+    from demfem.stress.fem_fit import DEFAULT_GRID, QUICK_GRID, fit_from_fem
 
     fit_from_fem(args.out, grid=QUICK_GRID if args.quick else DEFAULT_GRID, layers=args.layers,
                  young_modulus=args.young_modulus, scheduler=args.scheduler,
@@ -285,7 +285,7 @@ def _cmd_stress_model(args: argparse.Namespace) -> int:
 def _cmd_cluster(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from demfem.scenes.cluster import LOAD_CASES, CartridgeCluster
+    from demfem.scenes.cluster import LOAD_CASES, CartridgeCluster, cluster_from_run
     from demfem.studies.cluster_run import run_cluster
 
     overrides = {"springs": args.springs}
@@ -293,7 +293,9 @@ def _cmd_cluster(args: argparse.Namespace) -> int:
         overrides["elements"] = args.elements
     if args.layers is not None:
         overrides["layers"] = args.layers
-    if args.case in LOAD_CASES:
+    if args.from_run is not None:
+        cluster = cluster_from_run(Path(args.from_run), args.pick, **overrides)
+    elif args.case in LOAD_CASES:
         cluster = CartridgeCluster.load_case(args.case, **overrides)
     elif args.case.endswith(".toml"):
         import dataclasses
@@ -315,8 +317,15 @@ def _cmd_cluster(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_strength_fit(args: argparse.Namespace) -> int:
+    from demfem.risk.strength_file import strength_fit_command
+
+    return strength_fit_command(args)
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``demfem`` command."""
+    from demfem.assess.run import STEADY_DEFAULT, STEADY_FULL, duration_help
     p = _Parser(prog="demfem", description="DEM-FEM breakage of glass cartridges on a "
                 "conveyor-belt accumulation table (SI units).")
     p.add_argument("--version", action="version", version=f"demfem {package_version()}")
@@ -331,7 +340,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="recompute the FEM curve (two cartridges colliding; minutes) instead of "
                         "drawing the stored run")
     c.set_defaults(func=_cmd_calibrate)
-    r = sub.add_parser("run", help="the main job: calibration, DEM of a table scene, analysis")
+    r = sub.add_parser("run", help="calibration, DEM of a table scene and its analysis "
+                       "(no risk; the main job is 'demfem assess')")
     r.add_argument("scene", nargs="?", default=None, metavar="SCENE.toml",
                    help="table scene file (see examples/table_default.toml, or a "
                         "'mesh_table' scene: examples/mesh_table/mesh_table.toml; default: "
@@ -389,20 +399,24 @@ def build_parser() -> argparse.ArgumentParser:
                    help="simulated time, s (2.0)")
     e.add_argument("--out", default="demfem_out/equivalence", help="output directory")
     e.set_defaults(func=_cmd_equivalence)
-    a = sub.add_parser("assess", help="breakage risk: calibration, DEM, collision events, "
-                       "stress model, Weibull risk per cartridge and per hour, HTML report")
+    a = sub.add_parser("assess", help="the main job, breakage risk: calibration, DEM, "
+                       "collision events, stresses, Weibull risk per passage and per hour "
+                       "with its interval, HTML report")
     a.add_argument("scene", nargs="?", default=None, metavar="SCENE.toml",
                    help="table scene file (default: the built-in default table)")
     a.add_argument("--duration", type=float, default=None,
                    help="a fixed simulated time of the table, s, statistics over its second "
-                        "half (default: until the collision rate is steady, at most 12 s; "
-                        "--full: 30 s; --quick: 0.1 s)")
+                        "half (default: " + duration_help().replace("%", "%%") + ")")
     a.add_argument("--out", default="demfem_out/assess", help="output directory "
                    "(demfem_out/assess); the same settings there resume from the last "
                    "completed stage, other settings are refused")
     a.add_argument("--quick", action="store_true", help="a smoke run (0.1 s simulated)")
-    a.add_argument("--full", action="store_true", help="the full-accuracy run: until four gate "
-                   "periods agree within 10 %% (default: two within 15 %%)")
+    a.add_argument("--full", action="store_true", help=(
+        "the full-accuracy run: the mean impacts per gate period known to "
+        f"{100 * STEADY_FULL[1]:.0f} %% over at least {STEADY_FULL[0]} periods (default "
+        f"{100 * STEADY_DEFAULT[1]:.0f} %%, {STEADY_DEFAULT[0]})"))
+    a.add_argument("--csv", action="store_true", help="also write events.csv and "
+                   "passages.csv (the tables are Parquet with units in the schema)")
     a.add_argument("--no-refeed", action="store_true", help="run the scene as a batch that "
                    "drains (default: cartridges leaving are re-fed upstream, so the table "
                    "reaches a steady state)")
@@ -433,6 +447,13 @@ def build_parser() -> argparse.ArgumentParser:
     cl.add_argument("--case", default="max", metavar="max|avg|SCENE.toml",
                     help="load case: max (V2 0.18, V3 0.12 m/s), avg (0.05, 0.025) or a "
                          "cluster scene file (default max)")
+    cl.add_argument("--from", dest="from_run", default=None, metavar="RUN",
+                    help="take the load case from a DEM run: a demfem run or assess folder "
+                         "(its table_run.npz) or the .npz itself; the cluster gets the "
+                         "run's cartridge and glass (replaces --case)")
+    cl.add_argument("--pick", default="max", choices=("max", "typical"),
+                    help="with --from: the run's hardest double impact (max) or the median "
+                         "one (typical)")
     cl.add_argument("--springs", action="store_true",
                     help="hold 4-7 by no-tension springs to ghost neighbours")
     cl.add_argument("--elements", default=None, choices=("tet", "shell"),
@@ -448,6 +469,44 @@ def build_parser() -> argparse.ArgumentParser:
     cl.add_argument("--fresh", "--overwrite", dest="fresh", action="store_true",
                     help="replace the cluster run in --out")
     cl.set_defaults(func=_cmd_cluster)
+    sf = sub.add_parser("strength-fit", help="Weibull parameters of your own glass from "
+                        "strength tests (ASTM C1239 fit, C1683 scaling): writes a strength file")
+    sf.add_argument("data", metavar="DATA.csv", help="one specimen per row: strength_Pa or "
+                    "failure_stress_MPa, optional censored (0/1); see docs/strength.md")
+    sf.add_argument("--test", default="none",
+                    choices=("ring-on-ring", "side-compression", "burst", "none"),
+                    help="the strength test, for its effective area (none: --effective-area)")
+    for opt, what in (("--load-ring-diameter", "ring-on-ring: load ring diameter, m"),
+                      ("--support-ring-diameter", "ring-on-ring: support ring diameter, m"),
+                      ("--specimen-diameter", "ring-on-ring: disc diameter, m"),
+                      ("--outer-diameter", "side-compression, burst: tube outer diameter, m"),
+                      ("--wall-thickness", "side-compression, burst: tube wall, m"),
+                      ("--length", "side-compression, burst: loaded tube length, m"),
+                      ("--effective-area", "none: the test's effective area, m^2 "
+                       "(default: the reference area)")):
+        sf.add_argument(opt, type=float, default=None, help=what,
+                        metavar="M2" if opt == "--effective-area" else "METRES")
+    sf.add_argument("--poisson-ratio", type=float, default=0.2, help="ring-on-ring (0.2)")
+    sf.add_argument("--closed-ends", action="store_true", help="burst: closed tube ends")
+    sf.add_argument("--surface", default="outer", choices=("outer", "inner"),
+                    help="the cartridge surface whose flaws the specimens failed from (outer)")
+    sf.add_argument("--criterion", default="max_principal", choices=("max_principal", "pia"),
+                    help="effective-area criterion (max_principal, as demfem assess)")
+    sf.add_argument("--modulus", default="unbiased", choices=("unbiased", "ml"),
+                    help="m used for the scaling and the strength file (unbiased)")
+    sf.add_argument("--reference-area", type=float, default=1e-4,
+                    help="A_0 of the strength file, m^2 (1e-4)")
+    sf.add_argument("--confidence", type=float, default=0.90, help="of the bounds (0.90)")
+    sf.add_argument("--time-to-failure", type=float, default=None,
+                    help="typical duration of a test to failure, s (recorded, for slow "
+                         "crack growth)")
+    sf.add_argument("--simulations", type=int, default=20000,
+                    help="Monte Carlo samples of the bounds and the unbiasing factor (20000)")
+    sf.add_argument("--seed", type=int, default=1239, help="their seed (1239)")
+    sf.add_argument("--out", default="strength.json", help="strength file (strength.json)")
+    sf.add_argument("--merge", action="store_true",
+                    help="keep the other surface's fit already in --out")
+    sf.set_defaults(func=_cmd_strength_fit)
     return p
 
 

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from demfem.assess import STAGES, StressModel, assess, closed_form_model
-from demfem.assess.closed_form import (closed_form_coefficients, patch_centre_coefficients,
+from demfem.stress.shell import (closed_form_coefficients, patch_centre_coefficients,
                                        point_load_surface_stresses)
 from demfem.assess.events import EVENT_DTYPE
 from demfem.assess.figures import FIGURES
@@ -200,7 +200,8 @@ def test_wall_and_gate_impacts_are_events_and_the_belt_is_not():
 def small_job(tmp_path_factory):
     out = tmp_path_factory.mktemp("assess_full")
     lines = []
-    risk = assess(SMALL, out=out, duration=0.12, sample_interval=0.01, log=lines.append)
+    risk = assess(SMALL, out=out, duration=0.12, sample_interval=0.01, log=lines.append,
+                  csv=True)
     return out, risk, lines
 
 
@@ -208,13 +209,13 @@ def test_interrupted_assess_resumes_to_the_same_numbers(small_job, tmp_path):
     full_out, full, _ = small_job
     lines = []
     stopped = assess(SMALL, out=tmp_path, duration=0.12, sample_interval=0.01,
-                     log=lines.append, stop_after="dem")
+                     log=lines.append, stop_after="dem", csv=True)
     assert stopped == {"stopped_after": "dem"}
     book = json.loads((tmp_path / "stages.json").read_text())
     assert set(book["completed"]) == {"calibration", "dem"}
     lines = []
     resumed = assess(SMALL, out=tmp_path, duration=0.12, sample_interval=0.01,
-                     log=lines.append)
+                     log=lines.append, csv=True)
     text = "\n".join(lines)
     assert "1/6 calibration" in text and text.count("(done before: reused)") == 2
     assert json.loads((tmp_path / "risk.json").read_text())["summary"] == \
@@ -223,14 +224,15 @@ def test_interrupted_assess_resumes_to_the_same_numbers(small_job, tmp_path):
     assert (tmp_path / "events.csv").read_text() == (full_out / "events.csv").read_text()
     # a rerun skips every stage
     lines = []
-    assess(SMALL, out=tmp_path, duration=0.12, sample_interval=0.01, log=lines.append)
+    assess(SMALL, out=tmp_path, duration=0.12, sample_interval=0.01, log=lines.append,
+           csv=True)
     assert "\n".join(lines).count("(done before: reused)") == len(STAGES)
     # other settings: refused, naming the difference; --fresh replaces
     with pytest.raises(SettingsMismatchError, match="throughput_per_hour"):
         assess(SMALL, out=tmp_path, duration=0.12, sample_interval=0.01, throughput=100.0,
-               log=lines.append)
+               log=lines.append, csv=True)
     other = assess(SMALL, out=tmp_path, duration=0.12, sample_interval=0.01, throughput=100.0,
-                   fresh=True, log=lambda _: None)
+                   fresh=True, log=lambda _: None, csv=True)
     assert other["summary"]["throughput_per_hour"] == 100.0
 
 
@@ -256,7 +258,7 @@ def test_outputs_and_report(small_job):
         names = [a.get("Name") for a in piece.find("PointData")]
         assert field in names, (name, names)
     walls = [r for r in rows if r["partner"] == "wall"]
-    assert walls and all(r["j"] == "-1" and int(r["wall"]) > 0 for r in walls)  # never the belt
+    assert walls and all(r["j"] == "-1" and r["wall"] not in ("", "belt") for r in walls)
     assert doc["events"]["n_wall_events"] == len(walls)
     assert 0.0 <= doc["summary"]["wall_share"] <= 1.0
     # every hourly figure is one number: passages.csv, risk.json's three and the report's
@@ -273,6 +275,20 @@ def test_outputs_and_report(small_job):
     assert exposure / w == pytest.approx(s["mean_on_table"], rel=1e-7)
     from demfem.assess.headline import fmt
     assert fmt(s["broken_per_hour"]) in (out / "report.html").read_text()
+    # the Parquet tables, with units in their schema, are the CSV files' numbers
+    import pyarrow.parquet as pq
+
+    from demfem.assess.tables import load_assessment
+
+    a = load_assessment(out)
+    assert len(a.events) == len(rows) and len(a.passages) == len(rows_p)
+    assert a.summary == s
+    assert 3600.0 * a.passages["p_window"].sum() / w == pytest.approx(
+        s["broken_per_hour_table"], rel=1e-12)
+    assert np.allclose(a.events["force_N"], [float(r["force_N"]) for r in rows], rtol=1e-8)
+    schema = pq.read_schema(out / "events.parquet")
+    assert schema.field("force_N").metadata[b"unit"] == b"N"
+    assert schema.field("time_s").metadata[b"unit"] == b"s"
     html_text = (out / "report.html").read_text()
     imgs = re.findall(r'<img src="data:image/png;base64,([A-Za-z0-9+/=]+)"', html_text)
     assert len(imgs) == len(FIGURES)
@@ -374,7 +390,7 @@ def test_stress_model_refit_from_a_grid_of_fem_collisions(tmp_path):
     run serially through the sweep, three for training and one held back; the fitted model
     reproduces its training runs (the scaling σ1 = β F/t² is linear in F), reports its
     held-back error, loads back, and a rerun reuses the FEM runs."""
-    from demfem.assess.fem_fit import fit_from_fem
+    from demfem.stress.fem_fit import fit_from_fem
 
     grid = {"v_rel": [0.1, 0.2, 0.3, 0.4], "tilt_deg": [90.0]}
     lines = []

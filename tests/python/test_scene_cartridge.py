@@ -87,3 +87,22 @@ def test_assess_calibrates_the_scene_cartridge(tmp_path):
 def test_bad_cartridges_name_the_field(values, match):
     with pytest.raises(InvalidParameterError, match=match):
         AccumulationTable.from_dict(values)
+
+
+def test_cluster_from_a_dem_run_takes_its_cartridge_and_load_case(tmp_path):
+    """``demfem cluster --from RUN``: the load case from the run's onsets
+    (CartridgeCluster.from_collisions) with the run's cartridge and friction."""
+    from demfem.scenes.cluster import CartridgeCluster, cluster_from_run
+    from demfem.studies.table_run import run_table
+
+    t = AccumulationTable(**SMALL, cartridge=Cartridge(**THIN), friction=0.3)
+    run = run_table(t, 0.3, 0.01)
+    run.save(tmp_path / "table_run.npz")
+    c = cluster_from_run(tmp_path, "max", springs=True)
+    ref = CartridgeCluster.from_collisions(run.onsets, which="max")
+    assert (c.v2, c.v3, c.direction_2_deg, c.direction_3_deg) == (
+        ref.v2, ref.v3, ref.direction_2_deg, ref.direction_3_deg)
+    assert c.cartridge.geometry_dict() == t.cartridge.geometry_dict()
+    assert c.friction == 0.3 and c.springs
+    with pytest.raises(Exception, match="no table run"):
+        cluster_from_run(tmp_path / "nowhere")

@@ -4,10 +4,8 @@ per cartridge (calibration → DEM → collision events → stress model → Wei
 * :mod:`~demfem.assess.events` — impact events from the DEM's contact onsets;
 * :mod:`~demfem.assess.impact` — peak force, contact radius and duration of a collision
   (calibrated Hertz–Reissner law);
-* :mod:`~demfem.assess.closed_form` — surface stresses of a shell under a point load
-  (Reissner's shallow shell), the source of the default stress model;
-* :mod:`~demfem.assess.stress_model` — :class:`StressModel`: σ1 = β F/t² and stressed areas,
-  fit from FEM runs, JSON files;
+* :mod:`demfem.stress` — the stresses at a contact (contact field and shell bending) and
+  the former shell-only :class:`StressModel` (σ1 = β F/t²);
 * :mod:`~demfem.assess.stress_stage` — the per-event stresses;
 * :mod:`~demfem.assess.risk_stage` — probabilities per event, cartridge and hour, steady
   state, worst collisions, risk map;
@@ -21,6 +19,7 @@ from __future__ import annotations
 
 from demfem.assess.run import assess
 from demfem.assess.stages import STAGES
-from demfem.assess.stress_model import StressModel, closed_form_model
+from demfem.assess.tables import load_assessment
+from demfem.stress.stress_model import StressModel, closed_form_model
 
-__all__ = ["assess", "STAGES", "StressModel", "closed_form_model"]
+__all__ = ["assess", "STAGES", "StressModel", "closed_form_model", "load_assessment"]

@@ -38,10 +38,11 @@ from typing import Any
 
 import numpy as np
 
-from demfem.errors import check_range
+from demfem.errors import InvalidParameterError, check_range
 
 __all__ = ["EVENT_DTYPE", "DEFAULT_MIN_SPEED", "NOT_IMPACTS", "impact_events", "count_line",
-           "events_of_cartridge", "events_per_cartridge", "write_events_csv"]
+           "onset_digest", "without_onsets", "ONSET_SPEED_BINS",
+           "events_of_cartridge", "events_per_cartridge"]
 
 #: Walls whose contacts are not side impacts on a cartridge (the floor it stands on).
 NOT_IMPACTS = ("belt",)
@@ -144,6 +145,54 @@ def impact_events(run, min_speed: float = DEFAULT_MIN_SPEED,
                         names, measured=False)
 
 
+#: Bin edges (m/s) of the onset-speed histogram an assessment keeps instead of every onset.
+ONSET_SPEED_BINS = np.geomspace(1e-6, 10.0, 141)
+
+
+def _impact_walls(run) -> np.ndarray:
+    names = [str(n) for n in run.info.get("wall_names", [])]
+    w = np.asarray(run.wall_onsets)
+    n_walls = max(len(names), int(w["wall"].max()) + 1 if len(w) else 0)
+    return np.array([k >= len(names) or names[k] not in NOT_IMPACTS for k in range(n_walls)],
+                    bool)
+
+
+def onset_digest(run, min_speed: float) -> dict[str, Any]:
+    """What an assessment needs of a run's contact onsets, without the onsets: their counts
+    (between cartridges, with walls and gate, with the belt), how many impacts (not the belt)
+    began slower than ``min_speed`` (m/s) and the fastest of those, and the histogram of all
+    impact onsets' normal speeds over :data:`ONSET_SPEED_BINS` (m/s)."""
+    v_min = check_range("min_speed", min_speed, 0.0, math.inf, lo_open=False)
+    o, wo = np.asarray(run.onsets), np.asarray(run.wall_onsets)
+    impact = _impact_walls(run)
+    wo_impact = impact[np.asarray(wo["wall"], np.int64)] if len(wo) else np.zeros(0, bool)
+    speeds = np.concatenate([np.asarray(o["normal_speed"], float),
+                             np.asarray(wo["normal_speed"], float)[wo_impact]])
+    slow = speeds[speeds < v_min]
+    hist, _ = np.histogram(np.clip(speeds, ONSET_SPEED_BINS[0], ONSET_SPEED_BINS[-1]),
+                           bins=ONSET_SPEED_BINS)
+    return {"n_sphere_onsets": int(len(o)), "n_wall_onsets": int(len(wo)),
+            "n_belt_onsets": int(np.sum(~wo_impact)), "n_impact_onsets": int(len(speeds)),
+            "n_slow": int(len(slow)), "max_slow_speed_m_per_s": float(slow.max()) if len(slow)
+            else 0.0, "min_speed_m_per_s": v_min,
+            "speed_bins_m_per_s": ONSET_SPEED_BINS.tolist(),
+            "speed_counts": [int(c) for c in hist]}
+
+
+def without_onsets(run, min_speed: float):
+    """The run with its onsets replaced by their :func:`onset_digest` (in
+    ``info["onset_digest"]``): what an assessment keeps (the onsets of a default run are
+    ~250 MB; the digest is a few kB). Its measured contact events stay."""
+    import dataclasses
+
+    from demfem.analysis.collisions import ONSET_DTYPE, WALL_ONSET_DTYPE
+
+    digest = onset_digest(run, min_speed)
+    return dataclasses.replace(run, onsets=np.zeros(0, ONSET_DTYPE),
+                               wall_onsets=np.zeros(0, WALL_ONSET_DTYPE),
+                               info={**run.info, "onset_digest": digest})
+
+
 def count_line(summary: dict[str, Any]) -> str:
     """The events stage's counts in the one scheme the console and the report share:
     onsets = belt contacts + slower than the filter + events (pressed ones included)."""
@@ -203,9 +252,20 @@ def _measured_events(run, v_min: float, f_min: float) -> tuple[np.ndarray, dict[
     per_wall = {n: int(np.sum(w & (sel["j"] == k))) for k, n in enumerate(names)
                 if n not in NOT_IMPACTS}
     # the run may have stored only the events it was asked to keep: count the dropped from
-    # its onsets (every contact has one)
+    # its onsets (every contact has one), or from their digest
     o, wo = run.onsets, run.wall_onsets
-    if o is not None and wo is not None and len(o) + len(wo) >= len(c):
+    digest = run.info.get("onset_digest")
+    if digest is not None:
+        if not math.isclose(float(digest["min_speed_m_per_s"]), v_min, rel_tol=0, abs_tol=0):
+            raise InvalidParameterError(
+                f"invalid min_speed = {v_min!r}: the run kept only the digest of its onsets, "
+                f"made for min_speed = {digest['min_speed_m_per_s']!r} m/s")
+        n_drop = max(int(digest["n_impact_onsets"]) - len(ev), 0)
+        dropped = np.full(min(n_drop, int(digest["n_slow"])),
+                          float(digest["max_slow_speed_m_per_s"]))
+        n_all = int(digest["n_sphere_onsets"]) + int(digest["n_wall_onsets"])
+        n_belt = int(digest["n_belt_onsets"])
+    elif o is not None and wo is not None and len(o) + len(wo) >= len(c):
         wo_impact = impact_by_wall[np.asarray(wo["wall"], np.int64)] if n_walls else \
             np.ones(len(wo), bool)
         speeds = np.concatenate([np.asarray(o["normal_speed"], float),
@@ -235,33 +295,3 @@ def events_per_cartridge(events: np.ndarray, n: int) -> list[np.ndarray]:
         if j >= 0:
             out[int(j)].append(k)
     return [np.asarray(v, np.int64) for v in out]
-
-
-def write_events_csv(path, events: np.ndarray, extra: dict[str, np.ndarray]) -> None:
-    """Write the events and per-event ``extra`` columns (name with its unit → (n,) array) as
-    CSV, atomically."""
-    from demfem.assess.impact import PARTNERS
-    from demfem.io.atomic import write_text_atomic
-
-    head = ["event", "i", "j", "partner", "wall", "time_s", "x_m", "y_m", "z_m",
-            "normal_speed_m_per_s", "tangential_speed_m_per_s", "impact_angle_deg",
-            *extra.keys()]
-    lines = [",".join(head)]
-    cols = list(extra.values())
-    for k, e in enumerate(events):
-        row = [str(k), str(int(e["i"])), str(int(e["j"])), PARTNERS[int(e["partner"])],
-               str(int(e["wall"])),
-               f"{e['time']:.9g}", f"{e['x']:.6g}", f"{e['y']:.6g}", f"{e['z']:.6g}",
-               f"{e['normal_speed']:.6g}", f"{e['tangential_speed']:.6g}",
-               f"{math.degrees(e['impact_angle']):.4g}"]
-        row += [_fmt(c[k]) for c in cols]
-        lines.append(",".join(row))
-    write_text_atomic(path, "\n".join(lines) + "\n")
-
-
-def _fmt(x: Any) -> str:
-    if isinstance(x, (bool, np.bool_)):
-        return "1" if x else "0"
-    if isinstance(x, (int, np.integer)):
-        return str(int(x))
-    return f"{float(x):.6g}"

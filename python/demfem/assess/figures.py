@@ -12,11 +12,13 @@ __all__ = ["FIGURES", "make_figures"]
 
 #: File names of the figures, in report order, with their captions.
 FIGURES = {
-    "risk_map.png": "Where the risk comes from: breakage hazard Σ −ln(1 − P_k) of the window's "
-                    "collisions by contact point on the table (both partners counted); belt "
-                    "along +x, the opening at the right.",
-    "impact_speeds.png": "Normal impact speed at contact onset: every recorded onset and the "
-                         "events kept by the minimum-speed filter (dashed line).",
+    "risk_map.png": "Where on the table the risk comes from: each bin's share of the "
+                    "window's breakage hazard Σ −ln(1 − P_k) (both partners counted), by "
+                    "contact point, on the table's outline (walls black, gate red, the "
+                    "opening dotted); the labels give each wall's share of the hazard of its "
+                    "impacts; belt along +x.",
+    "impact_speeds.png": "Normal impact speed at contact onset: every impact onset (not the "
+                         "belt) and the events kept by the minimum-speed filter (dashed line).",
     "collision_rate.png": "Events per second against time; the statistics window is shaded, "
                           "with its two halves' mean rates (steadiness check).",
     "stress_model.png": "The stress model: peak σ1 on the inner and outer surface against "
@@ -36,7 +38,9 @@ def _png(fig) -> bytes:
 def make_figures(out: Path, data: dict[str, Any]) -> dict[str, bytes]:
     """Draw every figure of :data:`FIGURES` from ``data`` (the risk stage's arrays: ``map``,
     ``onset_speeds``, ``events``, ``window``, ``min_speed``, ``stress``, ``model``,
-    ``p_window``, ``steady``), write each PNG into ``out`` atomically and return
+    ``p_window``, ``steady``; optional ``walls`` (the table's walls with their ``top_view``
+    segments), ``wall_shares`` {wall name: share of the hazard} and ``opening`` (x_end,
+    w_min, w_max), m), write each PNG into ``out`` atomically and return
     {file name: PNG bytes}."""
     import matplotlib
 
@@ -50,33 +54,62 @@ def make_figures(out: Path, data: dict[str, Any]) -> dict[str, bytes]:
     t0, t1 = data["window"]
     figs: dict[str, bytes] = {}
 
-    # risk map
-    fig, ax = plt.subplots(figsize=(7, 3.8))
+    # risk map: on the table's outline, the share of the window's hazard per bin
+    fig, ax = plt.subplots(figsize=(7.5, 4.2))
     m = data["map"]
-    hz = np.where(m["hazard"] > 0, m["hazard"], np.nan).T
-    if np.any(np.isfinite(hz)):
-        im = ax.pcolormesh(m["x_edges"], m["y_edges"], hz, cmap="inferno_r",
-                           norm=LogNorm(vmin=np.nanmin(hz), vmax=np.nanmax(hz)))
-        fig.colorbar(im, ax=ax, label="hazard per bin (dimensionless)")
-    ax.contour(0.5 * (m["x_edges"][1:] + m["x_edges"][:-1]),
-               0.5 * (m["y_edges"][1:] + m["y_edges"][:-1]), m["count"].T,
-               levels=3, colors="0.5", linewidths=0.6)
-    ax.set_xlabel("x (belt direction), m")
+    total = float(np.sum(m["hazard"]))
+    if total > 0:
+        share = np.where(m["hazard"] > 0, 100.0 * m["hazard"] / total, np.nan).T
+        top = float(np.nanmax(share))
+        im = ax.pcolormesh(m["x_edges"], m["y_edges"], share, cmap="viridis",
+                           norm=LogNorm(vmin=top / 1e3, vmax=top), shading="flat")
+        fig.colorbar(im, ax=ax, label="share of the hazard per bin, % (3 decades)",
+                     extend="min")
+    for wall in data.get("walls", []):
+        seg = wall.get("top_view")
+        if seg is None:
+            continue
+        seg = np.asarray(seg, float)
+        gate = wall["name"] == "gate"
+        ax.plot(seg[:, 0], seg[:, 1], color="C3" if gate else "k", lw=3 if gate else 2,
+                solid_capstyle="butt")
+        share = data.get("wall_shares", {}).get(wall["name"])
+        if share is not None:
+            mid = seg.mean(axis=0)
+            ax.annotate(f"{wall['name'].replace('_', ' ')}: {100 * share:.0f} %", mid,
+                        xytext=(0, -12 if wall["name"] == "lower_side" else 6),
+                        textcoords="offset points", ha="center", fontsize=8,
+                        color="C3" if gate else "k")
+    if data.get("opening") is not None:
+        x_end, w_min, w_max = data["opening"]
+        ax.plot([x_end, x_end], [0.0, w_max], color="C3", ls=":", lw=1.5)
+        ax.annotate("opening", (x_end, 0.5 * w_max), xytext=(6, 0), textcoords="offset points",
+                    fontsize=8, color="C3", va="center")
+    ax.set_xlabel("x (belt direction →), m")
     ax.set_ylabel("y, m")
     ax.set_aspect("equal")
-    ax.set_title(f"hazard by position, window {t0:.3g}-{t1:.3g} s (grey: event counts)")
+    ax.set_title(f"where the hazard comes from, window {t0:.3g}–{t1:.3g} s "
+                 "(labels: share by wall)", fontsize=10)
     figs["risk_map.png"] = _png(fig)
     plt.close(fig)
 
     # impact speeds
     fig, ax = plt.subplots(figsize=(6, 3.5))
-    v_all = np.asarray(data["onset_speeds"], float)
-    v_all = v_all[v_all > 0]
-    if v_all.size:
-        bins = np.geomspace(max(v_all.min(), 1e-6), max(v_all.max(), 2e-6), 50).tolist()
-        ax.hist(v_all, bins=bins, color="0.7", label="all onsets")
+    onsets = data["onset_speeds"]
+    if isinstance(onsets, dict):  # the digest an assessment keeps: a histogram
+        bins = np.asarray(onsets["speed_bins_m_per_s"], float)
+        counts = np.asarray(onsets["speed_counts"], float)
+    else:
+        v_all = np.asarray(onsets, float)
+        v_all = v_all[v_all > 0]
+        bins = np.geomspace(max(v_all.min(), 1e-6), max(v_all.max(), 2e-6), 50) if v_all.size \
+            else np.geomspace(1e-6, 10.0, 50)
+        counts, _ = np.histogram(v_all, bins=bins)
+    if counts.sum():
+        ax.stairs(counts, bins, fill=True, color="0.7", label="impact onsets (not the belt)")
         if len(ev):
-            ax.hist(ev["normal_speed"], bins=bins, color="C3", alpha=0.7, label="events")
+            ax.hist(ev["normal_speed"], bins=bins, color="C3", alpha=0.7,
+                    label="events (pressed ones at their slow onset)")
     ax.axvline(data["min_speed"], color="k", ls="--", lw=1)
     ax.set_xscale("log")
     ax.set_yscale("log")

@@ -11,12 +11,12 @@ __all__ = ["save_npz", "load_npz", "flatten"]
 
 
 def save_npz(path: Path, **arrays: Any) -> Path:
-    """Write ``arrays`` to ``path`` (.npz) atomically; returns the path."""
+    """Write ``arrays`` to ``path`` (.npz, compressed) atomically; returns the path."""
     from demfem.io.atomic import atomic_path
 
     with atomic_path(path, suffix=".npz") as tmp:
         with open(tmp, "wb") as fh:
-            np.savez(fh, **arrays)
+            np.savez_compressed(fh, **arrays)
     return path
 
 

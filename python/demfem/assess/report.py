@@ -133,8 +133,10 @@ def render_report(risk: dict[str, Any], figures: dict[str, bytes],
     parts.append("</ul><h2>Settings</h2>")
     parts.append(_table([(k, v if not isinstance(v, (dict, list)) else str(v))
                          for k, v in risk["settings_flat"].items()], ("setting", "value")))
-    parts.append("<p>Files: risk.json (strict JSON), events.csv (one row per event), "
-                 "passages.csv (one row per passage of a cartridge over the table), "
-                 "stages.json (stage record), "
-                 "the figures as PNG.</p></body></html>")
+    parts.append("<p>Files: risk.json (strict JSON: the summary, the steady state, the worst "
+                 "collisions, the settings), events.parquet (one row per event) and "
+                 "passages.parquet (one row per passage of a cartridge over the table), each "
+                 "column named with its SI unit (demfem.assess.load_assessment reads them into "
+                 "pandas; --csv writes them as CSV too), events.vtp and cartridges.vtp "
+                 "(ParaView), stages.json (stage record), the figures as PNG.</p></body></html>")
     return "\n".join(parts)

@@ -1,5 +1,5 @@
-"""The risk stage's products: ``risk.json`` (strict JSON), ``events.csv``,
-``passages.csv`` and ``risk_arrays.npz`` (the arrays the figures are drawn from), with the
+"""The risk stage's products: ``risk.json`` (strict JSON), ``events.parquet``,
+``passages.parquet`` (CSV on request) and ``risk_arrays.npz`` (the arrays the figures are drawn from), with the
 statement of what each number rests on (``basis``) and the warnings of the report."""
 from __future__ import annotations
 
@@ -121,28 +121,14 @@ def _basis(model, scg, ev_summary: dict[str, Any], e_stress: float, table,
     return lines
 
 
-def _write_passages_csv(path: Path, run, table: np.ndarray, pr: dict[str, Any]) -> Path:
-    """``passages.csv``: one row per passage (a cartridge from insertion to exit)."""
-    from demfem.io.atomic import write_text_atomic
-
-    rows = ["passage,cartridge,tag,start_s,end_s,exited,exposure_in_window_s,"
-            "n_events_window,p_window,hazard"]
-    for k, ps in enumerate(table):
-        i = int(ps["particle"])
-        end = "" if not ps["exited"] else f"{ps['end']:.9g}"
-        rows.append(f"{k},{i},{int(run.tags[i])},{ps['start']:.9g},{end},"
-                    f"{int(ps['exited'])},{pr['exposure_s'][k]:.9g},{int(pr['n_events'][k])},"
-                    f"{pr['p_window'][k]:.9g},{pr['hazard'][k]:.9g}")
-    return write_text_atomic(path, "\n".join(rows) + "\n")
-
-
 def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[str, Any],
                   stress: dict[str, np.ndarray], model, scg, window: tuple[float, float],
                   throughput: Optional[float], settings: dict[str, Any],
-                  e_stress: float) -> list[Path]:
-    """Compute the risk stage and write its files into ``out``; returns their paths."""
-    from demfem.assess.events import write_events_csv
+                  e_stress: float, csv: bool = False) -> list[Path]:
+    """Compute the risk stage and write its files into ``out`` (``events.parquet``,
+    ``passages.parquet`` and, with ``csv``, the same as CSV); returns their paths."""
     from demfem.assess.npz import flatten, save_npz
+    from demfem.assess.tables import events_columns, passages_columns, write_table
     from demfem.io.strict_json import write_json_atomic
     from demfem.materials import PAPER_GLASS
     from demfem.risk import INNER_SURFACE, OUTER_SURFACE
@@ -249,9 +235,10 @@ def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[st
              "area_inner_m2": stress["area_inner_m2"], "area_outer_m2": stress["area_outer_m2"],
              "p_inner": p["p_inner"], "p_outer": p["p_outer"], "p_event": p["p_event"],
              "in_window": inside}
-    write_events_csv(out / "events.csv", events, extra)
-    files.append(out / "events.csv")
-    files.append(_write_passages_csv(out / "passages.csv", run, passages, pr))
+    files += write_table(out / "events.parquet", events_columns(events, extra, wall_names),
+                         csv)
+    files += write_table(out / "passages.parquet", passages_columns(passages, run.tags, pr),
+                         csv)
     files += _write_vtk(out, run, events, p, stress, passages, pr, inside)
     files.append(save_npz(out / "risk_arrays.npz", p_window=pr["p_window"],
                           p_event=p["p_event"],

@@ -8,7 +8,7 @@ per cartridge, in six resumable stages (:data:`demfem.assess.stages.STAGES`):
 3. **events** — impact events above the minimum speed (``events.npz``);
 4. **stress** — force, duration, σ1 and stressed area per event (``stress.npz``);
 5. **risk** — P per event, per cartridge and per hour, steady state, worst events, risk map
-   (``risk.json``, ``events.csv``, ``passages.csv``, ``risk_arrays.npz``);
+   (``risk.json``, ``events.parquet``, ``passages.parquet``, ``risk_arrays.npz``);
 6. **report** — ``report.html`` and the figures.
 
 SI units throughout: m, s, kg, N, Pa.
@@ -30,7 +30,7 @@ from demfem.stress.stress_model import StressModel
 from demfem.errors import InvalidParameterError, check_positive, check_range
 
 __all__ = ["assess", "OUTPUT_FILES", "QUICK_DURATION", "DEFAULT_DURATION", "FULL_DURATION",
-           "steady_rule"]
+           "steady_rule", "duration_help", "STEADY_DEFAULT", "STEADY_FULL"]
 
 #: Longest simulated time of the default run, s: it runs until the collision rate is steady
 #: (:func:`steady_rule`: the mean impacts per gate period known to 10 %), at most this long.
@@ -40,6 +40,21 @@ QUICK_DURATION = 0.1
 #: ``full``: until the mean is known to 5 % (at least 8 periods), at most this long, s
 #: (docs/assess.md gives the measured difference from the default).
 FULL_DURATION = 60.0
+
+
+#: The steady rule's (fewest gate periods, largest relative standard error of their mean
+#: impacts) of the default run and of ``full``.
+STEADY_DEFAULT = (4, 0.10)
+STEADY_FULL = (8, 0.05)
+
+
+def duration_help() -> str:
+    """The run-length rule in words, from the constants the code uses (for help texts)."""
+    return (f"until the collision rate is steady (the mean impacts per gate period known to "
+            f"{STEADY_DEFAULT[1]:.0%}, at least {STEADY_DEFAULT[0]} periods after a 2 s "
+            f"warm-up), at most {DEFAULT_DURATION:g} s; --full: to {STEADY_FULL[1]:.0%} over "
+            f"at least {STEADY_FULL[0]} periods, at most {FULL_DURATION:g} s; --quick: "
+            f"{QUICK_DURATION:g} s")
 
 
 def steady_rule(table, full: bool = False, min_speed: float = DEFAULT_MIN_SPEED):
@@ -52,13 +67,15 @@ def steady_rule(table, full: bool = False, min_speed: float = DEFAULT_MIN_SPEED)
 
     names = [str(w["name"]) for w in table.build().walls]
     return SteadyRule(period=float(table.gate_period) if table.gate_amplitude > 0 else 1.0,
-                      min_periods=8 if full else 4, warmup=2.0,
-                      tolerance=0.05 if full else 0.10, min_speed=min_speed,
+                      min_periods=(STEADY_FULL if full else STEADY_DEFAULT)[0], warmup=2.0,
+                      tolerance=(STEADY_FULL if full else STEADY_DEFAULT)[1],
+                      min_speed=min_speed,
                       excluded_walls=tuple(k for k, n in enumerate(names) if n in NOT_IMPACTS))
 
 #: Files the job writes (removed by a fresh start), besides the DEM checkpoint.
 OUTPUT_FILES = ("calibration.json", "table_run.npz", "events.npz", "stress.npz", "risk.json",
-                "events.csv", "passages.csv", "events.vtp", "cartridges.vtp",
+                "events.parquet", "passages.parquet", "events.csv", "passages.csv",
+                "events.vtp", "cartridges.vtp",
                 "risk_arrays.npz", "report.html")
 
 
@@ -82,7 +99,8 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
            stress_young_modulus: Optional[float] = None, slow_crack_growth: bool = True,
            threads: int = 1, checkpoint_every: float = 15.0,
            log: Callable[[str], None] = print, progress: bool = False,
-           stop_after: Optional[str] = None, refeed: bool = True) -> dict[str, Any]:
+           stop_after: Optional[str] = None, refeed: bool = True,
+           csv: bool = False) -> dict[str, Any]:
     """Run (or resume) the assessment; returns the risk document (``risk.json``'s content).
 
     Args:
@@ -90,11 +108,11 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
         out: output folder.
         duration: simulated time of the table, s, fixed (statistics over its second half, or
             from ``discard_before``). Default: run until the collision rate is steady
-            (:func:`steady_rule`), at most 12 s (``full``: 30 s), statistics over the
-            steady periods.
+            (:func:`steady_rule`, :func:`duration_help`), statistics over the steady
+            periods.
         quick: a smoke run (0.1 s simulated).
-        full: the full-accuracy run: until four gate periods agree within 10 % (the default:
-            two within 15 %).
+        full: the full-accuracy run (:data:`STEADY_FULL`: the mean known to 5 % over at least
+            8 gate periods, at most :data:`FULL_DURATION` s).
         throughput: cartridges per hour of the user's line, > 0; None (default): the table's
             own discharge in the simulation. Given, the report shows both.
         fresh: replace an assessment with other settings in ``out`` instead of refusing it.
@@ -113,6 +131,7 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
         refeed: re-insert upstream the cartridges that leave through the opening, so the table
             stays in operation (a batch that drains has no steady state); False runs the
             scene as it is.
+        csv: also write ``events.csv`` and ``passages.csv`` beside their Parquet files.
     """
     from demfem.pipeline import load_scene
     from demfem.risk import INNER_SURFACE, OUTER_SURFACE, SCG_BOROSILICATE
@@ -137,6 +156,8 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
             "statistics over its steady periods; give a fixed duration to choose the window")
     t0 = 0.5 * duration if discard_before is None else check_range(
         "discard_before", discard_before, 0.0, duration, lo_open=False)
+    if not isinstance(csv, bool):
+        raise InvalidParameterError(f"invalid csv = {csv!r}: must be True or False")
     if not isinstance(refeed, bool):
         raise InvalidParameterError(f"invalid refeed = {refeed!r}: must be True or False")
     check_positive("checkpoint_every", checkpoint_every)
@@ -170,7 +191,8 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
                 "slow_crack_growth": dataclasses.asdict(scg) if scg else None,
                 "inner_surface": dataclasses.asdict(INNER_SURFACE),
                 "outer_surface": dataclasses.asdict(OUTER_SURFACE),
-                "dem_model": table.contact_model, "dem_events": "measured"}
+                "dem_model": table.contact_model, "dem_events": "measured",
+                "tables": "parquet+csv" if csv else "parquet"}
     out = Path(out)
     from demfem.studies.table_run import remove_checkpoint
 
@@ -237,14 +259,19 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
         finally:
             if bar is not None:
                 bar.close()
+        from demfem.assess.events import without_onsets
+
+        run = without_onsets(run, v_min)  # their counts and speeds, not ~250 MB of onsets
         run.save(run_path)
         book.complete("dem", [run_path])
     else:
         run = TableRun.load(run_path)
+    dig = run.info.get("onset_digest") or {"n_sphere_onsets": len(run.onsets),
+                                             "n_wall_onsets": len(run.wall_onsets)}
     log(f"  {run.info['steps']} steps of {run.info['dt']:.3g} s, "
-        f"{len(run.onsets) + len(run.wall_onsets)} contact onsets ({len(run.onsets)} between "
-        f"cartridges, {len(run.wall_onsets)} with walls, gate and belt), wall "
-        f"{run.info['wall_time_s']:.1f} s")
+        f"{dig['n_sphere_onsets'] + dig['n_wall_onsets']} contact onsets "
+        f"({dig['n_sphere_onsets']} between cartridges, {dig['n_wall_onsets']} with walls, "
+        f"gate and belt), wall {run.info['wall_time_s']:.1f} s")
     end = float(run.info["duration"])
     if rule is not None:
         # the statistics window: every whole period since the warm-up
@@ -308,7 +335,7 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
     header(5, "Weibull probabilities per event, cartridge and hour", done)
     if not done:
         files = risk_document(out, run, table, events, ev_summary, stress, model, scg,
-                              (t0, end), q, settings, e_stress)
+                              (t0, end), q, settings, e_stress, csv=csv)
         book.complete("risk", files)
     risk = json.loads((out / "risk.json").read_text(encoding="utf-8"))
     s = risk["summary"]
@@ -327,14 +354,18 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
         arrays = load_npz(out / "risk_arrays.npz")
         figs = make_figures(out, {
             "map": {k: arrays[f"map_{k}"] for k in ("hazard", "count", "x_edges", "y_edges")},
-            "onset_speeds": run.onsets["normal_speed"], "events": events,
+            "onset_speeds": run.info.get("onset_digest") or run.onsets["normal_speed"],
+            "events": events,
             "window": (t0, end), "min_speed": v_min, "stress": stress, "model": model,
             "p_window": arrays["p_window"], "steady": risk["steady_state"],
+            "walls": table.walls(), "wall_shares": risk["summary"]["wall_share_by_wall"],
+            "opening": (table.x_end, table.min_opening_width, table.max_opening_width),
             "duration": end})
         html_path = write_text_atomic(out / "report.html",
                                       render_report(risk, figs, figures_names))
         book.complete("report", [html_path, *(out / n for n in figs)])
-    log(f"  written to {out}: report.html, risk.json, events.csv, passages.csv, "
+    log(f"  written to {out}: report.html, risk.json, events.parquet, passages.parquet"
+        + (" (and .csv)" if csv else "") + ", "
         "events.vtp, cartridges.vtp (ParaView), "
         + ", ".join(figures_names))
     return risk

@@ -70,7 +70,8 @@ from demfem.errors import InvalidParameterError, check_range
 from demfem.io.atomic import write_text_atomic
 from demfem.materials import PAPER_GLASS, Material
 
-__all__ = ["CartridgeCluster", "LOAD_CASES", "SITE_ANGLES_DEG", "ClusterParts"]
+__all__ = ["CartridgeCluster", "LOAD_CASES", "SITE_ANGLES_DEG", "ClusterParts",
+           "cluster_from_run"]
 
 SCENE_NAME = "cartridge_cluster"
 
@@ -438,7 +439,6 @@ class CartridgeCluster:
         if scene != SCENE_NAME:
             raise InvalidParameterError(f"invalid scene = {scene!r} in {source}: must be {SCENE_NAME!r}")
         flat = [f.name for f in dataclasses.fields(cls) if f.name != "cartridge"]
-        cart_fields = [f.name for f in dataclasses.fields(Cartridge) if f.name != "material"]
         geo = values.pop("cartridge", {}) or {}
         mat = values.pop("material", {}) or {}
         for key in values:
@@ -448,11 +448,6 @@ class CartridgeCluster:
                     + ", ".join(flat) + ", [cartridge], [material]")
         if not isinstance(geo, Mapping) or not isinstance(mat, Mapping):
             raise InvalidParameterError(f"invalid [cartridge]/[material] in {source}: must be tables")
-        for key in geo:
-            if key not in cart_fields:
-                raise InvalidParameterError(
-                    f"unknown key {key!r} in [cartridge] of {source}; allowed keys: "
-                    + ", ".join(cart_fields))
         for key in mat:
             if key not in ("E", "nu", "density", "name"):
                 raise InvalidParameterError(
@@ -462,7 +457,7 @@ class CartridgeCluster:
         material = Material(E=mat.get("E", base.E), nu=mat.get("nu", base.nu),
                             density=mat.get("density", base.density),
                             name=mat.get("name", base.name if not mat else "glass"))
-        cartridge = Cartridge(**dict(geo), material=material)
+        cartridge = Cartridge.from_geometry(geo, material, source)
         try:
             return cls(**values, cartridge=cartridge)
         except TypeError as exc:  # pragma: no cover - keys are checked above
@@ -537,3 +532,42 @@ def _impact_pairs(table: np.ndarray, window: float) -> list:
                 e1, e2 = sorted((events[a], events[b]), key=lambda e: -e[2])
                 out.append(((e1[2], e1[3], e1[4]), (e2[2], e2[3], e2[4])))
     return out
+
+
+def cluster_from_run(run: Any, which: str = "max", **overrides: Any) -> CartridgeCluster:
+    """The cluster whose load case comes from a DEM table run
+    (:meth:`CartridgeCluster.from_collisions` on its onsets), with the run's cartridge, glass
+    and friction. ``run``: a :class:`demfem.studies.table_run.TableRun`, a ``table_run.npz``
+    or the folder of a ``demfem run`` / ``demfem assess`` that holds one."""
+    from demfem.errors import DemfemIOError
+    from demfem.studies.table_run import TableRun
+
+    if not isinstance(run, TableRun):
+        path = Path(run)
+        f = path / "table_run.npz" if path.is_dir() else path
+        if not f.is_file():
+            raise DemfemIOError(f"invalid run {path}: no table run there (a demfem run or "
+                                "demfem assess folder holds table_run.npz)")
+        run = TableRun.load(f)
+        if not len(run.onsets) and (f.parent / "events.npz").is_file():
+            # an assessment keeps the digest of its onsets, and its events
+            return _cluster_from_events(run, f.parent / "events.npz", which, overrides)
+    table = run.table
+    values = {"cartridge": table.cartridge, "friction": table.friction, **overrides}
+    return CartridgeCluster.from_collisions(run.onsets, which=which, **values)
+
+
+def _cluster_from_events(run: Any, path: Path, which: str,
+                         overrides: dict[str, Any]) -> CartridgeCluster:
+    """:func:`cluster_from_run` from an assessment's events (cartridge–cartridge impacts)."""
+    from demfem.analysis.collisions import ONSET_DTYPE
+
+    with np.load(path, allow_pickle=False) as data:
+        ev = data["events"]
+    ev = ev[ev["partner"] == 0]
+    onsets = np.zeros(len(ev), ONSET_DTYPE)
+    for k in ("i", "j", "time", "normal_speed", "tangential_speed", "impact_angle"):
+        onsets[k] = ev[k]
+    table = run.table
+    values = {"cartridge": table.cartridge, "friction": table.friction, **overrides}
+    return CartridgeCluster.from_collisions(onsets, which=which, **values)
