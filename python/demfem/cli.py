@@ -265,6 +265,7 @@ def _cmd_assess(args: argparse.Namespace) -> int:
     result = assess(args.scene, out=args.out, duration=args.duration, quick=args.quick,
                     full=args.full, throughput=args.throughput, fresh=args.fresh,
                     threads=args.threads, stress_model=model, refeed=not args.no_refeed, csv=args.csv,
+                    strength=args.strength,
                     progress=True, log=lambda line: print(line, flush=True))
     if "summary" in result:
         from demfem.assess.headline import headline
@@ -415,6 +416,9 @@ def build_parser() -> argparse.ArgumentParser:
         "the full-accuracy run: the mean impacts per gate period known to "
         f"{100 * STEADY_FULL[1]:.0f} %% over at least {STEADY_FULL[0]} periods (default "
         f"{100 * STEADY_DEFAULT[1]:.0f} %%, {STEADY_DEFAULT[0]})"))
+    a.add_argument("--strength", default=None, metavar="FILE",
+                   help="a strength file of your own glass (demfem strength-fit); default: "
+                        "the planning assumptions of demfem.risk")
     a.add_argument("--csv", action="store_true", help="also write events.csv and "
                    "passages.csv (the tables are Parquet with units in the schema)")
     a.add_argument("--no-refeed", action="store_true", help="run the scene as a batch that "

@@ -397,3 +397,36 @@ def test_strength_fit_command_reports_bad_input_in_one_line(tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.startswith("demfem: error:") and "--support-ring-diameter" in err
     assert not (tmp_path / "s.json").exists()
+
+
+def test_assess_uses_the_users_strength_file(tmp_path):
+    """``demfem assess --strength FILE``: the file's Weibull parameters replace the planning
+    assumptions in the probabilities, and the report and risk.json name the source."""
+    import json
+
+    import numpy as np
+
+    from demfem.assess import assess
+    from demfem.cli import main
+    from demfem.scenes.table import AccumulationTable
+
+    strength = tmp_path / "strength.json"
+    assert main(["strength-fit", "examples/strength_data.csv", "--test", "ring-on-ring",
+                 "--load-ring-diameter", "0.008", "--support-ring-diameter", "0.016",
+                 "--specimen-diameter", "0.020", "--surface", "outer",
+                 "--out", str(strength)]) == 0
+    small = AccumulationTable(width=0.1, length=0.1, tilted_wall_length=0.05, n_spheres=30)
+    kw = dict(duration=0.12, sample_interval=0.01, log=lambda _: None)
+    base = assess(small, out=tmp_path / "a", **kw)
+    mine = assess(small, out=tmp_path / "b", strength=strength, **kw)
+    assert "strength.json" in mine["strength"]["source"] and mine["strength"]["measured"]
+    assert "strength.json" in (tmp_path / "b" / "report.html").read_text()
+    doc = json.loads((tmp_path / "b" / "risk.json").read_text())
+    outer = doc["settings"]["outer_surface"]
+    fitted = json.loads(strength.read_text())["surfaces"]["outer"]
+    assert outer["weibull_modulus"] == fitted["weibull_modulus"]
+    assert outer["characteristic_strength"] == fitted["characteristic_strength_Pa"]
+    # a stronger outer surface than the planning assumption: less outer hazard
+    pa = np.load(tmp_path / "a" / "risk_arrays.npz")["p_event"]
+    pb = np.load(tmp_path / "b" / "risk_arrays.npz")["p_event"]
+    assert pa.shape == pb.shape and np.all(pb <= pa) and pb.sum() < pa.sum()

@@ -54,6 +54,9 @@ def render_report(risk: dict[str, Any], figures: dict[str, bytes],
     from demfem.assess.headline import fmt, headline
 
     parts.append(f"<p class='headline'><b>{html.escape(headline(s))}</b></p>")
+    strength = risk.get("strength", {})
+    parts.append("<p>Glass strength: " + html.escape(strength.get(
+        "source", "planning assumptions of demfem.risk")) + ".</p>")
     parts.append("<h2>Summary</h2>")
     rows = [
         ("statistics window, s", f"{fmt(st['window_s'][0])} – {fmt(st['window_s'][1])}"),

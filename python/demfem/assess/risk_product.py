@@ -59,8 +59,8 @@ def _write_vtk(out: Path, run, events: np.ndarray, p: dict[str, np.ndarray],
 
 
 def _basis(model, scg, ev_summary: dict[str, Any], e_stress: float, table,
-           stress: dict[str, np.ndarray]) -> list[str]:
-    from demfem.risk import INNER_SURFACE, OUTER_SURFACE
+           stress: dict[str, np.ndarray], surfaces: dict[str, Any]) -> list[str]:
+    inner, outer = surfaces["inner"], surfaces["outer"]
 
     measured = ev_summary.get("measured") and math.isclose(float(table.young_modulus), e_stress,
                                                            rel_tol=1e-12)
@@ -98,14 +98,16 @@ def _basis(model, scg, ev_summary: dict[str, Any], e_stress: float, table,
         "closed form's ln(1/a) growth by about +-20 % over the DEM's force range; the "
         "cylinder (not a sphere) bends more; refit from FEM runs (StressModel.fit) before "
         "trusting absolute values.",
-        "Weibull strength (planning assumptions, NOT measured on any product): inner m = "
-        f"{INNER_SURFACE.weibull_modulus:g}, sigma_0 = {INNER_SURFACE.characteristic_strength:.3g}"
-        f" Pa; outer m = {OUTER_SURFACE.weibull_modulus:g}, sigma_0 = "
-        f"{OUTER_SURFACE.characteristic_strength:.3g} Pa; A_0 = "
-        f"{INNER_SURFACE.reference_area:g} m^2 ({INNER_SURFACE.source}; {OUTER_SURFACE.source})."
-        " With m = 6-10, a 20 % change of sigma_0 changes P by a factor 3-9: the absolute "
-        "probabilities are uncertain by orders of magnitude, their ratios between table "
-        "settings much less.",
+        ("Weibull strength (planning assumptions, NOT measured on any product)"
+         if not surfaces["measured"] else
+         f"Weibull strength (measured: {', '.join(surfaces['measured'])} surface)")
+        + f": inner m = {inner.weibull_modulus:.3g}, sigma_0 = "
+        f"{inner.characteristic_strength / 1e6:.4g} MPa on A_0 = {inner.reference_area:g} m^2; "
+        f"outer m = {outer.weibull_modulus:.3g}, sigma_0 = "
+        f"{outer.characteristic_strength / 1e6:.4g} MPa on A_0 = {outer.reference_area:g} m^2. "
+        f"Source: {surfaces['source']}. With m = 6-10, a 20 % change of sigma_0 changes P by a "
+        "factor 3-9: the absolute probabilities are only as good as the strength data, their "
+        "ratios between table settings much better.",
         ("Slow crack growth: half-sine pulse of the contact duration, equivalent static "
          f"stress over t_ref = {scg.reference_time:g} s with n = {scg.crack_growth_exponent:g} "
          f"({scg.source})." if scg is not None else
@@ -124,7 +126,8 @@ def _basis(model, scg, ev_summary: dict[str, Any], e_stress: float, table,
 def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[str, Any],
                   stress: dict[str, np.ndarray], model, scg, window: tuple[float, float],
                   throughput: Optional[float], settings: dict[str, Any],
-                  e_stress: float, csv: bool = False) -> list[Path]:
+                  e_stress: float, csv: bool = False,
+                  surfaces: Optional[dict[str, Any]] = None) -> list[Path]:
     """Compute the risk stage and write its files into ``out`` (``events.parquet``,
     ``passages.parquet`` and, with ``csv``, the same as CSV); returns their paths."""
     from demfem.assess.npz import flatten, save_npz
@@ -133,7 +136,10 @@ def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[st
     from demfem.materials import PAPER_GLASS
     from demfem.risk import INNER_SURFACE, OUTER_SURFACE
 
-    p = event_probabilities(stress, INNER_SURFACE, OUTER_SURFACE, scg)
+    if surfaces is None:
+        surfaces = {"inner": INNER_SURFACE, "outer": OUTER_SURFACE, "measured": [],
+                    "source": "planning assumptions of demfem.risk"}
+    p = event_probabilities(stress, surfaces["inner"], surfaces["outer"], scg)
     passages = run.passages()
     pr = passage_risk(events, p["p_event"], passages, window, throughput)
     rule = settings.get("until_steady") or {}
@@ -220,7 +226,8 @@ def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[st
                         "gate period of the default table): a smoke run, not an assessment.")
     doc = {"format": 2, "summary": summary, "steady_state": steady, "worst_events": worst,
            "events": ev_summary, "warnings": warnings,
-           "basis": _basis(model, scg, ev_summary, e_stress, table, stress),
+           "basis": _basis(model, scg, ev_summary, e_stress, table, stress, surfaces),
+           "strength": {"source": surfaces["source"], "measured": surfaces["measured"]},
            "window_s": list(window), "settings": settings,
            "settings_flat": {k: v for k, v in flatten(settings).items()
                              if not k.startswith("stress_model.units")}}

@@ -100,7 +100,7 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
            threads: int = 1, checkpoint_every: float = 15.0,
            log: Callable[[str], None] = print, progress: bool = False,
            stop_after: Optional[str] = None, refeed: bool = True,
-           csv: bool = False) -> dict[str, Any]:
+           csv: bool = False, strength: Optional[str | Path] = None) -> dict[str, Any]:
     """Run (or resume) the assessment; returns the risk document (``risk.json``'s content).
 
     Args:
@@ -132,9 +132,13 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
             stays in operation (a batch that drains has no steady state); False runs the
             scene as it is.
         csv: also write ``events.csv`` and ``passages.csv`` beside their Parquet files.
+        strength: a strength file (``demfem strength-fit``,
+            :func:`demfem.risk.strength_file.load_strength_file`) with the Weibull parameters
+            of the user's own glass; None: the planning assumptions of :mod:`demfem.risk`.
     """
     from demfem.pipeline import load_scene
     from demfem.risk import INNER_SURFACE, OUTER_SURFACE, SCG_BOROSILICATE
+    from demfem.risk.strength_file import load_strength_file
     from demfem.studies.table_run import check_run_arguments
 
     # every argument checked before any work
@@ -183,14 +187,23 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
     e_stress = float(table.young_modulus) if stress_young_modulus is None else check_positive(
         "stress_young_modulus", stress_young_modulus)
     scg = SCG_BOROSILICATE if slow_crack_growth else None
+    if strength is not None:
+        glass = load_strength_file(strength)
+        surfaces = {"inner": glass["inner"], "outer": glass["outer"],
+                    "source": glass["source"], "measured": list(glass["measured"])}
+    else:
+        surfaces = {"inner": INNER_SURFACE, "outer": OUTER_SURFACE,
+                    "source": "planning assumptions of demfem.risk (not measured on any "
+                              "product)", "measured": []}
     settings = {"scene": dataclasses.asdict(table), "duration_s": duration,
                 "sample_interval_s": float(sample_interval), "min_speed_m_per_s": v_min,
                 "statistics_from_s": None if rule else t0,
                 "until_steady": rule.to_dict() if rule else None, "throughput_per_hour": q,
                 "stress_young_modulus_Pa": e_stress, "stress_model": model.to_dict(),
                 "slow_crack_growth": dataclasses.asdict(scg) if scg else None,
-                "inner_surface": dataclasses.asdict(INNER_SURFACE),
-                "outer_surface": dataclasses.asdict(OUTER_SURFACE),
+                "inner_surface": dataclasses.asdict(surfaces["inner"]),
+                "outer_surface": dataclasses.asdict(surfaces["outer"]),
+                "strength_source": surfaces["source"],
                 "dem_model": table.contact_model, "dem_events": "measured",
                 "tables": "parquet+csv" if csv else "parquet"}
     out = Path(out)
@@ -335,7 +348,8 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
     header(5, "Weibull probabilities per event, cartridge and hour", done)
     if not done:
         files = risk_document(out, run, table, events, ev_summary, stress, model, scg,
-                              (t0, end), q, settings, e_stress, csv=csv)
+                              (t0, end), q, settings, e_stress, csv=csv,
+                              surfaces=surfaces)
         book.complete("risk", files)
     risk = json.loads((out / "risk.json").read_text(encoding="utf-8"))
     s = risk["summary"]
