@@ -52,6 +52,22 @@ class SettingsMismatchError(DemfemError, ValueError):
     the message names each setting that differs."""
 
 
+class OtherJobError(SettingsMismatchError):
+    """An output folder that holds another command's job (e.g. a ``demfem run`` folder given
+    to ``demfem assess``), or files of a job without its record; the message names the
+    command that made it and the way out (another folder, or ``--fresh`` to replace it)."""
+
+
+class FolderLockedError(DemfemIOError):
+    """An output folder that another running demfem process is writing (it holds the
+    folder's lock); the message names the folder and that process's PID."""
+
+
+class DemfemWarning(UserWarning):
+    """Something demfem repaired or assumed on the user's behalf (e.g. duplicate triangles
+    of a mesh file dropped); the message names the file and what was done."""
+
+
 class SimulationInterrupted(DemfemError, KeyboardInterrupt):
     """A run stopped cleanly at a step boundary (Ctrl-C); its state is consistent and can be
     checkpointed or continued."""
@@ -72,6 +88,9 @@ __all__ = [
     "as_real",
     "CheckpointError",
     "SettingsMismatchError",
+    "OtherJobError",
+    "FolderLockedError",
+    "DemfemWarning",
 ]
 
 

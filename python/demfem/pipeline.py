@@ -1,6 +1,6 @@
-"""The main job: the paper's pipeline on the built-in default scene, from one call.
+"""`demfem run`: the DEM of a table scene with its calibration and analysis, from one call.
 
-:func:`run_pipeline` runs, in order, every stage of the method that demfem has today:
+:func:`run_pipeline` runs, in order:
 
 1. **Calibration** of the equivalent sphere of the default 3 mL cartridge: mass, diameter,
    Reissner shell stiffness, Hertz contact time, Rayleigh step, and the Fig. 3 analogue (the
@@ -14,19 +14,24 @@
    collision statistics (impact speeds and angles at contact onset), spheres that left
    through the opening.
 
-The FEM of the seven-cartridge cluster and the breakage risk (stages 4-5 of the paper) are
-not in demfem yet; the report says so instead of inventing numbers.
+The breakage risk of the table is ``demfem assess`` (:func:`demfem.assess.assess`), the FEM
+of the seven-cartridge cluster ``demfem cluster``; the run's log points to both.
 
 Outputs in ``out``: ``calibration.csv`` and ``calibration_force_vs_E.png``, ``table_run.npz``
 (the whole record, :class:`demfem.studies.table_run.TableRun`), ``collisions.csv`` (one row
 per contact onset), ``summary.json``, ``table_time_series.png``, ``collisions.png``,
-``table_end.png``, a ParaView series ``vtk/table.pvd`` and ``run.json`` (the run's settings:
-the scene's TOML text and SHA-256, duration, sample interval, E, ...). Every file is written
-atomically; JSON files are strict (no NaN: null).
+``table_end.png``, a ParaView series ``vtk/table.pvd`` and ``run.json``, the folder's record
+(:class:`demfem.jobs.OutputFolder`: the command, the run's settings — the scene's TOML text
+and SHA-256, duration, sample interval, E, ... — and the SHA-256 of ``table_run.npz`` once
+the run is complete). Every file is written atomically; JSON files are strict (no NaN:
+null).
 
-An output folder that holds another run is refused (:class:`~demfem.errors.
-SettingsMismatchError` naming the settings that differ) unless ``fresh=True``, which removes
-the old run's outputs first; one that holds the same run resumes it.
+The folder is locked while the run writes it. A folder that holds another command's job or
+a run with other settings is refused (:class:`~demfem.errors.OtherJobError`,
+:class:`~demfem.errors.SettingsMismatchError` naming the settings that differ) unless
+``fresh=True``, which removes the old job's outputs first; one that holds the same run
+resumes it, and reuses a complete one after checking its ``table_run.npz`` against the
+recorded SHA-256 (a changed file is refused by name, :class:`~demfem.errors.CheckpointError`).
 
 SI units throughout: m, s, kg, N, Pa.
 """
@@ -34,27 +39,29 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
-import json
-import math
 from pathlib import Path
-from typing import Any, Callable, Optional
+from typing import Any, Callable, Mapping, Optional
 
 import numpy as np
 
-from demfem.errors import (CheckpointError, SettingsMismatchError, SimulationInterrupted,
-                           check_positive, check_range)
+from demfem.errors import (CheckpointError, SimulationInterrupted, check_positive,
+                           check_range)
 
-__all__ = ["run_pipeline", "load_scene", "NOT_YET", "OUTPUT_FILES"]
+__all__ = ["run_pipeline", "load_scene", "OUTPUT_FILES", "COMMAND", "NEXT_STEPS"]
 
-#: The paper's stages demfem does not run yet (printed by the report, kept in the summary).
-NOT_YET = ("FEM of the seven-cartridge cluster (stage 4)",
-           "breakage probability per cartridge from the DEM collisions (stage 5)")
+#: The job's name in its folder's record.
+COMMAND = "demfem run"
 
-#: Files a run writes into its output folder (besides the ``vtk/`` series): removed by a
-#: fresh start so that no old output stays beside the new ones.
+#: What to run next, printed at the end of the run.
+NEXT_STEPS = ("the breakage risk of this table: demfem assess [SCENE.toml]",
+              "the FEM of the seven-cartridge cluster (Figs. 10-13): demfem cluster")
+
+#: Files a run writes into its output folder (glob patterns; its checkpoint and the ``vtk/``
+#: series included): removed by a fresh start so that no old output stays beside the new
+#: ones.
 OUTPUT_FILES = ("calibration.csv", "calibration_force_vs_E.png", "table_run.npz",
                 "collisions.csv", "collisions.png", "summary.json", "table_time_series.png",
-                "table_end.png", "run.json")
+                "table_end.png", "table.ck*", "vtk/table_*.vtp", "vtk/table.pvd")
 _CHECKPOINT = "table.ck"
 _RUN_RECORD = "run.json"
 
@@ -85,53 +92,15 @@ def _settings(table, duration: float, sample_interval: float, v_rel: float,
             "statistics_from_s": float(discard), "model": model}
 
 
-def _clear_outputs(out: Path) -> None:
-    """Remove a previous run's outputs (and only those) from ``out``."""
-    from demfem.studies.table_run import remove_checkpoint
+def _compare(recorded: Mapping[str, Any], now: Mapping[str, Any]) -> list[str]:
+    """The differences that refuse a resume, with the scene named as one setting (its TOML
+    text is in the record for the user, its SHA-256 is compared)."""
+    from demfem.jobs import settings_differences
 
-    for name in OUTPUT_FILES:
-        (out / name).unlink(missing_ok=True)
-    remove_checkpoint(out / _CHECKPOINT)
-    vtk = out / "vtk"
-    if vtk.is_dir():
-        for p in (*vtk.glob("table_*.vtp"), vtk / "table.pvd"):
-            p.unlink(missing_ok=True)
-        if not any(vtk.iterdir()):
-            vtk.rmdir()
-
-
-def _prepare_folder(out: Path, settings: dict[str, Any], fresh: bool) -> Optional[dict]:
-    """Check ``out`` against this run's settings; returns the previous run's record when it
-    is the same run (to resume or reuse), else None after clearing the old outputs (fresh)
-    or refusing them."""
-    from demfem.io.atomic import clean_stale_temporaries
-    from demfem.io.strict_json import read_record
-    from demfem.studies.table_run import settings_differences
-
-    clean_stale_temporaries(out)
-    record_path = out / _RUN_RECORD
-    previous = read_record(record_path, ("settings",), fresh, "run record", "demfem run")
-    if not record_path.exists() and not fresh and any(
-            (out / n).exists() for n in ("summary.json", "table_run.npz", _CHECKPOINT, "vtk")):
-        raise SettingsMismatchError(
-            f"the output folder {out} holds another run (without a run record {_RUN_RECORD}"
-            "): choose another output folder, or replace it (fresh=True, demfem run "
-            "--fresh)")
-    if previous is not None and not fresh:
-        old = dict(previous["settings"])
-        diff = settings_differences({k: v for k, v in old.items() if k != "scene_toml"},
-                                    {k: v for k, v in settings.items() if k != "scene_toml"})
-        if diff:
-            raise SettingsMismatchError(
-                f"the output folder {out} holds a run with other settings ("
-                + "; ".join(d if not d.startswith("scene_sha256") else
-                            "scene: another scene file or other scene values"
-                            for d in diff)
-                + "): use the same settings to resume it, another output folder, or "
-                "replace it (fresh=True, demfem run --fresh)")
-        return previous
-    _clear_outputs(out)
-    return None
+    diff = settings_differences({k: v for k, v in recorded.items() if k != "scene_toml"},
+                                {k: v for k, v in now.items() if k != "scene_toml"})
+    return [d if not d.startswith("scene_sha256") else
+            "scene: another scene file or other scene values" for d in diff]
 
 
 def run_pipeline(out: str | Path = "demfem_out/run", duration: float = 1.0,
@@ -167,14 +136,11 @@ def run_pipeline(out: str | Path = "demfem_out/run", duration: float = 1.0,
         The summary (also written to ``summary.json``): calibration, the run's numbers,
         collision statistics and the output paths.
     """
-    from demfem.calibration import calibration_report, force_vs_modulus, write_calibration
-    from demfem.cartridge import Cartridge
-    from demfem.io.strict_json import write_json_atomic
-    from demfem.progress import ProgressBar
-    from demfem.studies.table_run import (TableRun, check_run_arguments, checkpoint_state,
-                                          run_table, sha256_file)
+    from demfem.jobs import OutputFolder
 
     # every argument checked before any work
+    from demfem.studies.table_run import check_run_arguments
+
     check_run_arguments(duration, sample_interval, threads)
     v_rel = check_positive("v_rel", v_rel)
     discard = 0.5 * duration if discard_before is None else check_range(
@@ -183,15 +149,27 @@ def run_pipeline(out: str | Path = "demfem_out/run", duration: float = 1.0,
     if young_modulus is not None:
         table = dataclasses.replace(table, young_modulus=check_positive("young_modulus",
                                                                          young_modulus))
-    model = table.contact_model
-    settings = _settings(table, duration, sample_interval, v_rel, discard, model)
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    previous = _prepare_folder(out, settings, fresh)
-    record_path = out / _RUN_RECORD
-    record = {"format": 1, "status": "running", "settings": settings}
-    if previous is None or previous.get("status") != "complete":
-        write_json_atomic(record_path, record)
+    settings = _settings(table, duration, sample_interval, v_rel, discard, table.contact_model)
+    with OutputFolder(out, COMMAND, settings, fresh=fresh, outputs=OUTPUT_FILES,
+                      record=_RUN_RECORD, compare=_compare) as folder:
+        return _run(folder, table, duration, sample_interval, threads, v_rel, discard,
+                    checkpoint_every, log, progress)
+
+
+def _run(folder, table, duration: float, sample_interval: float, threads: int, v_rel: float,
+         discard: float, checkpoint_every: float, log: Callable[[str], None],
+         progress: bool | Callable[[float, int], None]) -> dict[str, Any]:
+    """The run in its (locked, checked) output folder."""
+    from demfem.calibration import calibration_report, force_vs_modulus, write_calibration
+    from demfem.cartridge import Cartridge
+    from demfem.io.strict_json import write_json_atomic
+    from demfem.progress import ProgressBar
+    from demfem.studies.table_run import TableRun, checkpoint_state, run_table
+
+    out = folder.path
+    complete = folder.fields.get("status") == "complete"
+    if not complete:
+        folder.update(status="running")
 
     # 1. calibration
     log("== 1. calibration: the equivalent sphere ==")
@@ -207,21 +185,18 @@ def run_pipeline(out: str | Path = "demfem_out/run", duration: float = 1.0,
     run_path = out / "table_run.npz"
     checkpoint = out / _CHECKPOINT
     run = None
-    if previous is not None and previous.get("status") == "complete" and run_path.exists():
-        if sha256_file(run_path) != previous.get("table_run_sha256"):
-            raise CheckpointError(f"damaged run file {run_path}: its SHA-256 differs from the "
-                                  f"one in {record_path}; start afresh (fresh=True, demfem "
-                                  "run --fresh)")
-        run = TableRun.load(run_path)
+    if complete and run_path.exists():
+        run = TableRun.load(_verified_run(folder, run_path))
         log(f"  the same run is complete in {out}: its record is reused")
     if run is None:
         bar = ProgressBar(duration, label="table") if progress is True else None
         callback = bar if bar is not None else (progress if callable(progress) else None)
         try:
             try:
-                run = run_table(table, duration, sample_interval, threads=threads, model=model,
-                                progress=callback, checkpoint=checkpoint,
-                                checkpoint_every=checkpoint_every, fresh=fresh)
+                run = run_table(table, duration, sample_interval, threads=threads,
+                                model=table.contact_model, progress=callback,
+                                checkpoint=checkpoint, checkpoint_every=checkpoint_every,
+                                fresh=folder.fresh)
             finally:
                 if bar is not None:
                     bar.close()
@@ -235,6 +210,7 @@ def run_pipeline(out: str | Path = "demfem_out/run", duration: float = 1.0,
                     "of wall time): nothing to resume")
             raise
         run.save(run_path)
+        folder.add_files([run_path])
     info = run.info
     log(f"  {info['steps']} steps of {info['dt']:.3g} s in {info['wall_time_s']:.1f} s wall "
         f"({table.n_spheres * info['steps'] / max(info['wall_time_s'], 1e-9):.3g} "
@@ -248,14 +224,26 @@ def run_pipeline(out: str | Path = "demfem_out/run", duration: float = 1.0,
                               "models": list(cal.models), "max_force_N": cal.forces.tolist()},
               **result}
     result["files"] = [str(p) for p in (cal_csv, cal_png, run_path)] + result["files"]
-    result["not_yet"] = list(NOT_YET)
-    log("\n== not in demfem yet ==")
-    for stage in NOT_YET:
-        log(f"  {stage}")
+    log("\n== next ==")
+    for step in NEXT_STEPS:
+        log(f"  {step}")
     summary_path = write_json_atomic(out / "summary.json", result)
-    write_json_atomic(record_path, {**record, "status": "complete",
-                                    "table_run_sha256": sha256_file(run_path)})
+    folder.update(status="complete")
     log(f"\nwritten to {out}: " + ", ".join(str(Path(p).relative_to(out))
                                           for p in result["files"])
-        + f", {summary_path.name}, {record_path.name}")
+        + f", {summary_path.name}, {folder.record_path.name}")
     return result
+
+
+def _verified_run(folder, run_path: Path) -> Path:
+    """``table_run.npz`` of a complete run, checked against the SHA-256 in the record (a
+    record of an earlier version names it ``table_run_sha256``)."""
+    from demfem.jobs import sha256_file
+
+    if folder.relative(run_path) in folder.files:
+        return folder.verify(run_path)
+    legacy = folder.fields.get("table_run_sha256")
+    if legacy is None or sha256_file(run_path) != legacy:
+        raise CheckpointError(f"damaged run file {run_path}: its SHA-256 differs from the "
+                              f"one in {folder.record_path}; start afresh ({folder.fresh_hint})")
+    return run_path

@@ -23,7 +23,7 @@ from demfem.assess.impact import ImpactLaw, cartridge_body, flat_partner, impact
 from demfem.assess.passages import passages
 from demfem.assess.risk_stage import (equivalent_stress, event_probabilities, passage_risk,
                                       surface_probability)
-from demfem.assess.stress_stage import collision_stresses
+from demfem.stress.stage import collision_stresses
 from demfem.cli import main
 from demfem.contact import ContactBody, hertz_contact_duration, max_contact_force
 from demfem.errors import InvalidParameterError, SettingsMismatchError
@@ -112,7 +112,7 @@ def test_impact_duration_reduces_to_hertz_and_table_interpolates():
 
 def test_collision_stresses_use_the_calibrated_law():
     m = StressModel.default()
-    s = collision_stresses(np.array([0.01, 0.05]), np.array([0, 1]), m, 45e9)
+    s = collision_stresses(np.array([0.01, 0.05]), np.array([0, 1]), 45e9, model=m)
     body = cartridge_body(45e9)
     assert s["force_N"][0] == pytest.approx(max_contact_force(body, body, 0.01), rel=1e-5)
     assert s["force_N"][1] == pytest.approx(
@@ -134,7 +134,7 @@ def _synthetic_events(speeds, times=None):
 
 def _risk(speeds):
     ev = _synthetic_events(speeds)
-    st = collision_stresses(ev["normal_speed"], ev["partner"], StressModel.default(), 45e9)
+    st = collision_stresses(ev["normal_speed"], ev["partner"], 45e9, model=StressModel.default())
     p = event_probabilities(st)
     return ev, st, p, passage_risk(ev, p["p_event"], passages(4, [], []), (0.5, 1.0), 6000)
 
@@ -463,3 +463,38 @@ def test_a_reduced_modulus_is_flagged_with_its_measured_effect(tmp_path):
     assert "reduced Young's modulus" in text and "Spearman 0.92" in text
     assert not risk["summary"]["forces_measured"]
     assert any("calibrated law at the onset speed" in line for line in lines)
+
+
+def test_contact_stress_stage_matches_demfem_stress_per_partner():
+    """The stage's contact model is demfem.stress.contact_stresses with the measured friction
+    force (capped at mu F): crossed cartridges, walls along the body."""
+    from demfem.cartridge import Cartridge
+    from demfem.materials import PAPER_GLASS
+    from demfem.stress import contact_stresses
+
+    f = np.array([2.0, 45.0, 10.0])
+    q = np.array([0.1, 20.0, np.nan])  # the second above mu F: capped at 0.2 x 45 N
+    s = collision_stresses(np.zeros(3), np.array([0, 0, 1]), 45e9,
+                           measured_force=f, measured_impulse=f * 1e-4,
+                           measured_tangential=q, friction=0.2)
+    assert s["tangential_force_N"].tolist() == [0.1, 9.0, 0.0]
+    pair = contact_stresses(f[:2], [0.1, 9.0], geometry="crossed", material=PAPER_GLASS,
+                            friction_coefficient=0.2)
+    wall = contact_stresses(f[2:], 0.0, geometry="wall",
+                            contact_length=Cartridge().body_length, material=PAPER_GLASS)
+    assert np.allclose(s["sigma_outer_Pa"][:2], pair.outer_sigma1_max, rtol=1e-12)
+    assert np.allclose(s["sigma_inner_Pa"][:2], pair.inner_sigma1_max, rtol=1e-12)
+    assert np.allclose(s["area_outer_m2"][2:], wall.outer_effective_area, rtol=1e-12)
+    # the Hertz edge tension (1 - 2 nu) p0 / 3 of two crossed cartridges without friction
+    still = collision_stresses(np.zeros(1), np.zeros(1, np.int64), 45e9,
+                               measured_force=np.array([45.0]),
+                               measured_impulse=np.array([45e-4]))
+    p0 = still["p0_Pa"][0]
+    assert still["sigma_outer_contact_Pa"][0] == pytest.approx((1 - 2 * 0.22) * p0 / 3,
+                                                               rel=1e-9)
+    # the shell-only model on request
+    old = collision_stresses(np.zeros(1), np.zeros(1, np.int64), 45e9, model="shell",
+                             measured_force=np.array([45.0]),
+                             measured_impulse=np.array([45e-4]))
+    assert old["sigma_inner_Pa"][0] == pytest.approx(
+        StressModel.default().sigma_inner(np.array([45.0]))[0])

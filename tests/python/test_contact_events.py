@@ -12,8 +12,8 @@ import pytest
 from demfem.analysis.contact_events import CONTACT_EVENT_DTYPE, events_per_partner
 from demfem.assess.events import impact_events
 from demfem.assess.impact import ImpactLaw, cartridge_body
-from demfem.assess.stress_model import StressModel
-from demfem.assess.stress_stage import collision_stresses
+from demfem.stress.stress_model import StressModel
+from demfem.stress.stage import collision_stresses
 from demfem.dem import DemSimulation, material
 from demfem.scenes import AccumulationTable
 from demfem.studies import run_table
@@ -60,7 +60,7 @@ def test_a_binary_impact_is_measured_as_the_calibrated_law_says(v):
     # the stress stage's measured path: the measured peak, and the half-sine of the same
     # peak and impulse, which lasts between 0.854 (pure Hertz: pi / (2.94 x 5/4)) and 1 (a
     # linear spring's half-sine) of the series law's pulse
-    st = collision_stresses(np.array([v]), np.array([0]), StressModel.default(), 45e9,
+    st = collision_stresses(np.array([v]), np.array([0]), 45e9, model=StressModel.default(),
                             measured_force=np.array([f]), measured_impulse=np.array([j]))
     assert st["force_N"][0] == f and st["law_force_N"][0] == pytest.approx(f, rel=2e-3)
     assert st["duration_s"][0] == pytest.approx(0.5 * math.pi * j / f)
@@ -147,7 +147,7 @@ def test_measured_events_keep_hard_pressed_slow_contacts_and_drop_the_belt():
     assert np.all(ev["measured"]) and list(ev["peak_force"]) == [5.0, 2.0, 3.0]
     assert summary["measured"] and summary["n_belt_contacts"] == 1
     assert summary["n_dropped"] == 1 and summary["wall_events"]["gate"] == 1
-    st = collision_stresses(ev["normal_speed"], ev["partner"], StressModel.default(), 45e9,
+    st = collision_stresses(ev["normal_speed"], ev["partner"], 45e9, model=StressModel.default(),
                             measured_force=ev["peak_force"], measured_impulse=ev["impulse"])
     np.testing.assert_allclose(st["force_N"], [5.0, 2.0, 3.0])
     np.testing.assert_allclose(st["duration_s"], 0.5 * np.pi * ev["impulse"] / ev["peak_force"])

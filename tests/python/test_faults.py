@@ -340,3 +340,276 @@ def test_subnormal_modulus_in_rayleigh_step_is_refused_naming_E():
         contact.rayleigh_time_step(1.0, 5e-324, 0.0, 1.0)
     with pytest.raises(InvalidParameterError, match="invalid E = 5e-324"):
         _core.rayleigh_time_step(1.0, 5e-324, 0.0, 1.0)
+
+
+# ---- issue 43: damaged state refused by name, absurd scenes refused before running ------------
+
+def _tiny_cluster(young_modulus: float = 1e8):
+    from demfem.cartridge import Cartridge
+    from demfem.materials import Material
+    from demfem.scenes import CartridgeCluster
+
+    tube = Cartridge.tube(11.6e-3, 1.1e-3, 10e-3, material=Material(young_modulus, 0.22, 2230.0))
+    return CartridgeCluster.load_case("max", layers=1, cartridge=tube)
+
+
+def _cluster_checkpoint(out, monkeypatch):
+    """A cluster run stopped just after its first checkpoint."""
+    from demfem.studies import cluster_run
+
+    save = cluster_run._save_checkpoint
+
+    def save_then_stop(*args, **kwargs):
+        save(*args, **kwargs)
+        raise _Stop
+
+    monkeypatch.setattr(cluster_run, "_save_checkpoint", save_then_stop)
+    with pytest.raises(_Stop):
+        cluster_run.run_cluster(_tiny_cluster(), duration=3e-4, out=out, progress=False,
+                                n_snapshots=2, checkpoint_every=1e-9)
+    monkeypatch.setattr(cluster_run, "_save_checkpoint", save)
+    assert (out / "checkpoint.state").exists() and (out / "checkpoint.npz").exists()
+
+
+def _flip(path, at=None):
+    data = bytearray(path.read_bytes())
+    data[len(data) // 2 if at is None else at] ^= 0x04
+    path.write_bytes(bytes(data))
+
+
+@pytest.mark.parametrize("which", ["checkpoint.state", "checkpoint.npz"])
+def test_a_flipped_bit_in_the_cluster_checkpoint_is_refused_by_name(tmp_path, monkeypatch, which):
+    from demfem.studies.cluster_run import run_cluster
+
+    _cluster_checkpoint(tmp_path, monkeypatch)
+    _flip(tmp_path / which)
+    with pytest.raises(CheckpointError, match=rf"{which}.*demfem cluster --fresh"):
+        run_cluster(_tiny_cluster(), duration=3e-4, out=tmp_path, progress=False,
+                    n_snapshots=2)
+
+
+def test_a_rewritten_cluster_run_npz_is_refused_by_name(tmp_path, monkeypatch):
+    from demfem.studies import cluster_run
+
+    monkeypatch.setattr(cluster_run, "_write_outputs", lambda *args: {})  # figures: slow
+    cluster_run.run_cluster(_tiny_cluster(), duration=3e-4, out=tmp_path, progress=False,
+                            n_snapshots=2)
+    with np.load(tmp_path / "run.npz") as z:
+        data = {k: z[k] for k in z.files}
+    data["fn_12_bottom"] = 2.0 * data["fn_12_bottom"]  # "doubled forces"
+    np.savez_compressed(tmp_path / "run.npz", **data)
+    with pytest.raises(CheckpointError, match=r"run\.npz cannot be reused: its SHA-256 "
+                                              r"differs.*demfem cluster --fresh"):
+        cluster_run.run_cluster(_tiny_cluster(), duration=3e-4, out=tmp_path, progress=False,
+                                n_snapshots=2)
+
+
+def test_a_cluster_without_the_impact_it_was_set_up_for_is_a_numerical_error(tmp_path):
+    from demfem.studies.cluster_run import run_cluster
+
+    # E = 1e3 Pa: a step of 0.5 ms, six steps in 3 ms, no contact force at all
+    with pytest.raises(NumericalError, match=r"no contact between cartridges 1 and 2.*0 N.*"
+                                             r"E = 1e\+03 Pa"):
+        run_cluster(_tiny_cluster(1e3), duration=3e-3, out=tmp_path, progress=False,
+                    n_snapshots=2)
+    assert not (tmp_path / "run.npz").exists()
+
+
+def _ball_model():
+    from demfem.fem import Body, FemModel, RigidPlane
+    from demfem.fem.mesh import ball_tet_mesh
+    from demfem.materials import Material
+
+    ball = ball_tet_mesh(5e-3, 3).placed(translation=(0.0, 0.0, 5.2e-3))
+    return FemModel([Body(ball, velocity=(0.0, 0.0, -0.1))], Material(1e8, 0.22, 2230.0),
+                    rigid=[RigidPlane()])
+
+
+@pytest.mark.parametrize("damage, why", [
+    ("flip", "a byte changed"), ("truncate", "truncated"), ("garbage", "not a demfem FEM state"),
+    ("raw", "earlier demfem version"),
+])
+def test_fem_restore_state_refuses_a_damaged_file_by_name(tmp_path, damage, why):
+    model = _ball_model()
+    model.run(2e-5)
+    path = model.save_state(tmp_path / "ball.state")
+    u = model.solver.displacement()
+    if damage == "flip":
+        _flip(path, at=len(path.read_bytes()) - 100)
+    elif damage == "truncate":
+        path.write_bytes(path.read_bytes()[:-7])
+    elif damage == "garbage":
+        path.write_bytes(b"\x00garbage" * 40)
+    else:  # the core's bytes without the header of save_state
+        path.write_bytes(bytes(model.solver.save_state()))
+    other = _ball_model()
+    with pytest.raises(CheckpointError, match=rf"ball\.state.*{why}.*--fresh"):
+        other.restore_state(path)
+    assert other.time == 0.0  # unchanged
+    np.testing.assert_array_equal(model.solver.displacement(), u)
+
+
+def test_fem_state_of_another_model_names_the_file():
+    from demfem.errors import ShapeError
+    from demfem.fem import Body, FemModel
+    from demfem.fem.mesh import ball_tet_mesh
+    from demfem.materials import Material
+
+    import tempfile
+    from pathlib import Path
+
+    with tempfile.TemporaryDirectory() as d:
+        path = _ball_model().save_state(Path(d) / "a.state")
+        other = FemModel([Body(ball_tet_mesh(5e-3, 2))], Material(1e8, 0.22, 2230.0))
+        with pytest.raises(ShapeError, match=r"a\.state does not fit this model"):
+            other.restore_state(path)
+
+
+def test_fem_step_counts_beyond_the_limit_name_the_field_not_overflow():
+    from demfem.fem import ContactOptions
+
+    with pytest.raises(InvalidParameterError, match=r"invalid output_interval = 18446744073709551615"
+                                                    r".*\[1, 2000000000\]"):
+        ContactOptions(output_interval=2**64 - 1)
+    with pytest.raises(InvalidParameterError, match="invalid output_interval = 2.5"):
+        ContactOptions(output_interval=2.5)
+    with pytest.raises(InvalidParameterError, match=r"invalid sample_every = 18446744073709551615"):
+        _ball_model().run(1e-6, sample_every=2**64 - 1)
+    with pytest.raises(InvalidParameterError, match=r"invalid duration = 1e\+300.*steps"):
+        _ball_model().run(1e300)
+
+
+def test_float_tet_indices_are_refused_not_truncated():
+    from demfem.fem.mesh import ShellMesh, TetMesh
+
+    nodes = np.array([[0.0, 0, 0], [1e-3, 0, 0], [0, 1e-3, 0], [0, 0, 1e-3]])
+    with pytest.raises(InvalidParameterError, match=r"invalid tets: dtype float64; must be "
+                                                    r"integer node indices"):
+        TetMesh(nodes, np.array([[0.0, 1.0, 2.0, 3.7]]))
+    with pytest.raises(InvalidParameterError, match=r"invalid triangles: dtype bool"):
+        ShellMesh(nodes, np.ones((1, 3), bool), np.array([1e-3]))
+    with pytest.raises(InvalidParameterError, match=r"element 0 = \[0, 1, 2, 4\].*\[0, 4\)"):
+        TetMesh(nodes, np.array([[0, 1, 2, 4]]))
+    assert TetMesh(nodes, np.array([[0, 1, 2, 3]], np.int32)).n_elements == 1
+
+
+def test_the_shell_mesher_refuses_a_huge_mesh_naming_target_size():
+    from demfem.cartridge import Cartridge
+    from demfem.fem.mesh import cartridge_shell_mesh, cartridge_tet_mesh
+
+    t = time.monotonic()
+    with pytest.raises(InvalidParameterError, match=r"invalid target_size = 1e-06 m: the "
+                                                    r"shell mesh would have 524320768 triangles"):
+        cartridge_shell_mesh(Cartridge(), target_size=1e-6, n_theta=4096)
+    # without n_theta the message names target_size (not the n_theta it derives)
+    for mesher in (cartridge_shell_mesh, cartridge_tet_mesh):
+        with pytest.raises(InvalidParameterError, match=r"invalid target_size = 1e-06 m: .*"
+                                                        r"n_theta = 36443.*at least 8\.9e-06"):
+            mesher(Cartridge(), target_size=1e-6)
+    assert time.monotonic() - t < 2.0
+    assert cartridge_shell_mesh(Cartridge(), target_size=1e-3, n_theta=48).n_elements == 6432
+
+
+def test_a_damaged_table_run_file_is_refused_by_name(tmp_path):
+    from demfem.studies.table_run import TableRun
+
+    path = tmp_path / "table_run.npz"
+    path.write_bytes(b"PK\x03\x04" + bytes(200))
+    with pytest.raises(CheckpointError, match="table_run.npz"):
+        TableRun.load(path)
+
+
+def _mesh_table(**changes):
+    """A small mesh-table scene document: one belt 1 m x 0.3 m along +x, the inlet at its
+    upstream end, the outlet plane near its downstream end."""
+    doc = {"scene": "mesh_table", "duration": 1.0,
+           "belts": [{"polygon": [[0, 0], [1, 0], [1, 0.3], [0, 0.3]], "velocity": [0.2, 0]}],
+           "infeed": {"rate": 60, "region": [[0, 0], [0.1, 0.3]], "velocity": [0.2, 0]},
+           "outlet": {"point": [0.9, 0, 0], "normal": [1, 0, 0]}}
+    for key, value in changes.items():
+        if isinstance(value, dict) and isinstance(doc.get(key), dict):
+            doc[key] = {**doc[key], **value}
+        else:
+            doc[key] = value
+    return doc
+
+
+@pytest.mark.parametrize("changes, message", [
+    ({"outlet": {"point": [0.05, 0, 0]}},  # the outlet plane upstream of part of the inlet
+     r"invalid outlet in scene: the inlet site .* past the outlet plane"),
+    ({"outlet": {"normal": [-1, 0, 0]}},  # the whole table on the exit side
+     r"invalid outlet in scene: the inlet site .* past the outlet plane"),
+    ({"lost_below": 0.01}, r"invalid lost_below = 0\.01 m in scene: must be below the belts"),
+    ({"lost_below": 0.0}, r"invalid lost_below = 0\.0 m"),
+    ({"infeed": {"region": [[1.2, 0], [1.4, 0.3]]}, "outlet": {"point": [2, 0, 0]}},
+     r"invalid infeed\.region .* not over any belt"),
+    ({"particles": {"pool": 1_000_000_000}},
+     r"invalid particles\.pool = 1000000000 in scene: .* about 1e\+03 GB .* more than the "
+     r"limit"),
+    ({"materials": {"glass": {"young_modulus": 1e3}}},
+     r"invalid materials\.glass\.young_modulus = 1000 Pa in scene: .* sink .* fall through "
+     r"the belt"),
+    ({"particles": {"pool": 2.5}}, r"invalid particles\.pool in scene = 2\.5: must be a whole"),
+    ({"threads": 1.0}, r"invalid threads in scene = 1\.0: must be a whole"),
+    ({"window": 1e-300}, r"invalid window"),
+    ({"infeed": {"region": [[0, 0], [1e300, 0.3]]}}, r"invalid infeed\.region"),
+    ({"belts": [{"polygon": [[0, 0], [1e6, 0], [1e6, 1], [0, 1]]}]}, r"invalid belts\[0\]"),
+    ({"particles": 3}, r"invalid \[particles\] of scene = 3: must be a table"),
+    ({"materials": [1]}, r"invalid materials in scene"),
+    ({"belts": "x"}, r"invalid belts in scene: must be a list"),
+    ({"effects": "gravity"}, r"invalid effects = 'gravity'"),
+])
+def test_an_absurd_mesh_table_is_refused_before_anything_is_allocated(changes, message):
+    from demfem.scenes.mesh_table import MeshTable
+
+    t = time.monotonic()
+    with pytest.raises(InvalidParameterError, match=message):
+        MeshTable.from_dict(_mesh_table(**changes))
+    assert time.monotonic() - t < 2.0
+    MeshTable.from_dict(_mesh_table())  # the sane one is accepted
+
+
+def test_an_stl_with_every_triangle_twice_is_deduplicated_with_a_warning(tmp_path):
+    from demfem.errors import DemfemWarning
+    from demfem.io.stl import read_stl, write_stl
+
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0.0]])
+    t = np.array([[0, 1, 2], [1, 3, 2]])
+    write_stl(tmp_path / "floor.stl", v, np.vstack([t, t, t[:, ::-1]]))  # twice, and flipped
+    with pytest.warns(DemfemWarning, match=r"floor\.stl: 4 of its 6 triangles repeat an earlier"
+                                          r" one .* dropped"):
+        vertices, triangles = read_stl(tmp_path / "floor.stl")
+    np.testing.assert_array_equal(triangles, t)
+    write_stl(tmp_path / "once.stl", v, t)
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        read_stl(tmp_path / "once.stl")  # no warning for a clean mesh
+
+
+def test_an_stl_at_1e300_m_names_the_coordinates_not_weld_tolerance(tmp_path):
+    from demfem.io.stl import read_stl, write_stl
+
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0.0]]) * 1e300
+    with np.errstate(all="ignore"):  # the normals of such a triangle overflow
+        write_stl(tmp_path / "far.stl", v, np.array([[0, 1, 2]]), binary=False)
+    with pytest.raises(InvalidParameterError, match=r"far\.stl: coordinates up to 1e\+300 m .*"
+                                                    r"is the unit right") as exc:
+        read_stl(tmp_path / "far.stl")
+    assert "weld_tolerance" not in str(exc.value)
+
+
+def test_a_binary_scene_file_is_refused_naming_it(tmp_path, capsys):
+    from demfem.cli import main
+    from demfem.scenes.mesh_table import MeshTable
+
+    path = tmp_path / "scene.toml"
+    path.write_bytes(bytes(range(256)) * 4)
+    for load in (AccumulationTable.from_toml, MeshTable.from_toml):
+        with pytest.raises(InvalidParameterError, match=r"invalid scene file .*scene\.toml: "
+                                                        r"not UTF-8 text"):
+            load(path)
+    assert main(["run", str(path), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert "scene.toml" in err and err.count("\n") == 1 and "Traceback" not in err

@@ -1,7 +1,9 @@
 """kill -9 at any moment loses nothing already written: a `demfem run` or `demfem assess`
 killed after its first DEM checkpoint, or a `demfem cluster` FEM run killed after its first
 FEM checkpoint, leaves only complete files, and the same call started again resumes and
-ends with the numbers of an uninterrupted run (issues 28, 30)."""
+ends with the numbers of an uninterrupted run (issues 28, 30). While the first process
+runs, a second one started into its folder is refused at once naming its PID; the killed
+one leaves no lock behind (issue 43)."""
 import json
 import os
 import signal
@@ -56,7 +58,8 @@ def _kill_after_checkpoint_and_resume(code: str, tmp_path: Path, final: str,
                                       checkpoint: str = "table.ck.json") -> tuple[Path, Path]:
     """Run ``code`` to the end in ``ref``; in ``killed``, SIGKILL it just after its first
     checkpoint (the file ``checkpoint`` appears; ``final`` must not be there yet and every
-    file must be whole), then run it again to the end. Returns (ref, killed)."""
+    file must be whole; a second process started meanwhile is refused naming the first's
+    PID), then run it again to the end. Returns (ref, killed)."""
     ref, killed = tmp_path / "ref", tmp_path / "killed"
     subprocess.run([sys.executable, "-c", code, str(ref)], check=True, timeout=600)
     proc = subprocess.Popen([sys.executable, "-c", code, str(killed)])
@@ -65,7 +68,10 @@ def _kill_after_checkpoint_and_resume(code: str, tmp_path: Path, final: str,
     while not meta.exists() and proc.poll() is None and time.time() - t0 < 300:
         time.sleep(0.05)
     assert proc.poll() is None, "the run ended before its first checkpoint"
-    time.sleep(0.2)  # somewhere past the checkpoint, mid-step
+    second = subprocess.run([sys.executable, "-c", code, str(killed)], timeout=120,
+                            capture_output=True, text=True)
+    assert second.returncode != 0 and proc.poll() is None
+    assert "FolderLockedError" in second.stderr and f"PID {proc.pid}" in second.stderr
     os.kill(proc.pid, signal.SIGKILL)
     proc.wait(timeout=30)
     assert proc.returncode == -signal.SIGKILL

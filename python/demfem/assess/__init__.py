@@ -6,7 +6,7 @@ per cartridge (calibration → DEM → collision events → stress model → Wei
   (calibrated Hertz–Reissner law);
 * :mod:`demfem.stress` — the stresses at a contact (contact field and shell bending) and
   the former shell-only :class:`StressModel` (σ1 = β F/t²);
-* :mod:`~demfem.assess.stress_stage` — the per-event stresses;
+* :mod:`~demfem.stress.stage` — the per-event stresses;
 * :mod:`~demfem.assess.risk_stage` — probabilities per event, cartridge and hour, steady
   state, worst collisions, risk map;
 * :mod:`~demfem.assess.stages`, :mod:`~demfem.assess.run` — the resumable job

@@ -21,8 +21,11 @@ FIGURES = {
                          "belt) and the events kept by the minimum-speed filter (dashed line).",
     "collision_rate.png": "Events per second against time; the statistics window is shaded, "
                           "with its two halves' mean rates (steadiness check).",
-    "stress_model.png": "The stress model: peak σ1 on the inner and outer surface against "
-                        "peak contact force, and the window's events on the inner line.",
+    "stress_model.png": "The stresses: peak σ1 on the outer (blue) and inner (red) surface of "
+                        "each event of the window against its peak force (dots: two "
+                        "cartridges, crosses: walls and gate; the outer stress of an event "
+                        "rises with its friction force), over the model's curves for two "
+                        "cartridges without friction and sliding.",
     "cartridge_risk.png": "Breakage probability of each passage (a cartridge from insertion "
                           "to exit) over its time in the statistics window (log scale; "
                           "passages without any risk-bearing event are not drawn).",
@@ -137,20 +140,31 @@ def make_figures(out: Path, data: dict[str, Any]) -> dict[str, bytes]:
     figs["collision_rate.png"] = _png(fig)
     plt.close(fig)
 
-    # stress model
-    fig, ax = plt.subplots(figsize=(6, 3.5))
-    model = data["model"]
+    # stress model: the window's events on top of the model's curves for two cartridges
+    fig, ax = plt.subplots(figsize=(6.4, 3.8))
     st = data["stress"]
-    fmax = max(float(np.max(st["force_N"])) if len(st["force_N"]) else 1.0, 1e-3)
-    f = np.linspace(0.0, 1.1 * fmax, 50)
-    ax.plot(f, model.sigma_inner(f) / 1e6, color="C3", label=f"inner, β = {model.beta_inner:.3g}")
-    ax.plot(f, model.sigma_outer(f) / 1e6, color="C0", label=f"outer, β = {model.beta_outer:.3g}")
     inside = (ev["time"] >= t0) & (ev["time"] <= t1)
-    ax.plot(st["force_N"][inside], st["sigma_inner_Pa"][inside] / 1e6, ".", ms=2,
-            color="C3", alpha=0.3)
+    curves = data.get("stress_curves")
+    if curves is not None:
+        fc = np.asarray(curves["force_N"], float)
+        ax.plot(fc, np.asarray(curves["sigma_outer_sliding_Pa"]) / 1e6, color="C0", lw=1,
+                label=f"outer, two cartridges sliding at μ = {curves['friction']:g}", zorder=1)
+        ax.plot(fc, np.asarray(curves["sigma_outer_Pa"]) / 1e6, color="C0", lw=1, ls="--",
+                label="outer, no friction", zorder=1)
+        ax.plot(fc, np.asarray(curves["sigma_inner_Pa"]) / 1e6, color="C3", lw=1,
+                label="inner (bending)", zorder=1)
+    wall = inside & (ev["partner"] == 1)
+    pair = inside & (ev["partner"] == 0)
+    for sel, marker, who in ((pair, ".", "cartridges"), (wall, "x", "walls, gate")):
+        ax.scatter(st["force_N"][sel], st["sigma_outer_Pa"][sel] / 1e6, s=4, marker=marker,
+                   color="C0", alpha=0.5, zorder=3, label=f"events with {who}: outer")
+        ax.scatter(st["force_N"][sel], st["sigma_inner_Pa"][sel] / 1e6, s=4, marker=marker,
+                   color="C3", alpha=0.5, zorder=3, label=f"events with {who}: inner")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
     ax.set_xlabel("peak contact force F, N")
     ax.set_ylabel("peak σ1, MPa")
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=7, loc="upper left")
     figs["stress_model.png"] = _png(fig)
     plt.close(fig)
 

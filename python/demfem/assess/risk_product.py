@@ -58,8 +58,34 @@ def _write_vtk(out: Path, run, events: np.ndarray, p: dict[str, np.ndarray],
     return files
 
 
+def _stress_basis(model: Any, settings: dict[str, Any]) -> str:
+    """What the stresses rest on, in words."""
+    from demfem.stress.stress_model import StressModel
+
+    if isinstance(model, StressModel) or model == "shell":
+        m = StressModel.default() if model == "shell" else model
+        return (f"Stress model (shell bending only): sigma1 = beta F/t^2 with beta_inner = "
+                f"{m.beta_inner:.4g}, beta_outer = {m.beta_outer:.4g}, t = {m.thickness:g} m; "
+                f"stressed areas {m.area_factor_inner:.4g} (inner) and "
+                f"{m.area_factor_outer:.4g} (outer) times the Hertz patch pi a^2. Source: "
+                f"{m.source}. It leaves out the contact stress on the outer surface.")
+    pair = settings.get("pair_geometry", "crossed")
+    return ("Stress model (demfem.stress, docs/stress.md): on the outer surface the contact "
+            "field with the measured friction force (Hertz; Hamilton 1983: the trailing-edge "
+            "tension p0 [(1 - 2 nu)/3 + (4 + nu) pi mu/8]) on top of the shell's bending, on "
+            "the inner surface the bending tension under the load (Reissner's shallow shell, "
+            "the ring under a line load); Weibull effective areas of both fields. The DEM's "
+            "spheres carry no axis, so the geometry is assumed: two cartridges "
+            + ("crossed at 90 degrees (a point contact: the severe case)" if pair == "crossed"
+               else "side by side along the body (a line contact)")
+            + ", walls and gate along the body (a line contact); mid-body, away from the rim "
+            "and the shoulder. No flaw-depth correction (conservative where the contact field "
+            "is shallower than the flaws).")
+
+
 def _basis(model, scg, ev_summary: dict[str, Any], e_stress: float, table,
-           stress: dict[str, np.ndarray], surfaces: dict[str, Any]) -> list[str]:
+           stress: dict[str, np.ndarray], surfaces: dict[str, Any],
+           settings: Optional[dict[str, Any]] = None) -> list[str]:
     inner, outer = surfaces["inner"], surfaces["outer"]
 
     measured = ev_summary.get("measured") and math.isclose(float(table.young_modulus), e_stress,
@@ -91,13 +117,7 @@ def _basis(model, scg, ev_summary: dict[str, Any], e_stress: float, table,
         + f" ({ev_summary['n_dropped']} slower onsets dropped, the fastest of them at "
         f"{ev_summary['max_dropped_speed_m_per_s']:.3g} m/s). {ev_summary['note']}.",
         force_line,
-        f"Stress model: sigma1 = beta F/t^2 with beta_inner = {model.beta_inner:.4g}, "
-        f"beta_outer = {model.beta_outer:.4g}, t = {model.thickness:g} m; stressed areas "
-        f"{model.area_factor_inner:.4g} (inner) and {model.area_factor_outer:.4g} (outer) "
-        f"times the Hertz patch pi a^2. Source: {model.source}. A constant beta misses the "
-        "closed form's ln(1/a) growth by about +-20 % over the DEM's force range; the "
-        "cylinder (not a sphere) bends more; refit from FEM runs (StressModel.fit) before "
-        "trusting absolute values.",
+        _stress_basis(model, settings or {}),
         ("Weibull strength (planning assumptions, NOT measured on any product)"
          if not surfaces["measured"] else
          f"Weibull strength (measured: {', '.join(surfaces['measured'])} surface)")
@@ -121,6 +141,34 @@ def _basis(model, scg, ev_summary: dict[str, Any], e_stress: float, table,
         "as long as the table holds that population.",
     ]
     return lines
+
+
+def _interval(events: np.ndarray, p: dict[str, np.ndarray], inside: np.ndarray,
+              window: tuple[float, float], period: Optional[float], wall_names: list[str],
+              pr: dict[str, Any]) -> dict[str, Any]:
+    """The 95 % interval of the hourly number over whole gate periods (block totals,
+    Student-t on the log scale: :func:`demfem.risk.interval.hourly_interval_from_events`),
+    with its splits by place on the table, by partner and by surface (mechanism), carried
+    onto the headline figures as relative bounds. Without two whole periods: no interval."""
+    from demfem.risk.interval import hourly_interval_from_events
+
+    block = float(period) if period else 1.0
+    ci = hourly_interval_from_events(events[inside], p["p_event"][inside], window, block,
+                                     wall_names=wall_names,
+                                     p_surfaces={"inner": p["p_inner"][inside],
+                                                 "outer": p["p_outer"][inside]})
+
+    def carried(value: float) -> Optional[list[float]]:
+        if not (ci.estimable and ci.estimate > 0 and math.isfinite(value)):
+            return None
+        return [value * ci.lower / ci.estimate, value * ci.upper / ci.estimate]
+
+    doc = ci.to_dict()
+    doc["note"] = ("per hour at the table's own state, over the whole gate periods of the "
+                   "window (block totals of the hazard, Student-t on the log scale); the "
+                   "headline's interval is this one's relative width carried onto it")
+    return {"headline": carried(pr["broken_per_hour"]),
+            "table": carried(pr["broken_per_hour_table"]), "document": doc}
 
 
 def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[str, Any],
@@ -163,6 +211,7 @@ def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[st
                for k, name in enumerate(wall_names)
                if h_all > 0 and np.any(inside & (events["wall"] == k))}
     w = pr["window_s"]
+    ci = _interval(events, p, inside, window, period, wall_names, pr)
 
     def mx(a: np.ndarray) -> Optional[float]:
         return float(np.max(a)) if a.size else None
@@ -182,6 +231,8 @@ def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[st
         "broken_per_hour_table": pr["broken_per_hour_table"],
         "broken_per_hour_small_p": pr["broken_per_hour_small_p"],
         "broken_per_hour_at_throughput": pr["broken_per_hour_at_throughput"],
+        "broken_per_hour_ci95": ci["headline"],
+        "broken_per_hour_table_ci95": ci["table"],
         "unassigned_events": pr["unassigned_events"],
         "inner_share": h_in / (h_in + h_out) if h_in + h_out > 0 else math.nan,
         "n_wall_events_window": int(np.sum(inside & (events["partner"] == 1))),
@@ -224,9 +275,10 @@ def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[st
     if w < 0.5:
         warnings.append(f"Short statistics window ({w:.3g} s, less than a quarter of the "
                         "gate period of the default table): a smoke run, not an assessment.")
-    doc = {"format": 2, "summary": summary, "steady_state": steady, "worst_events": worst,
+    doc = {"format": 2, "summary": summary, "interval": ci["document"],
+           "steady_state": steady, "worst_events": worst,
            "events": ev_summary, "warnings": warnings,
-           "basis": _basis(model, scg, ev_summary, e_stress, table, stress, surfaces),
+           "basis": _basis(model, scg, ev_summary, e_stress, table, stress, surfaces, settings),
            "strength": {"source": surfaces["source"], "measured": surfaces["measured"]},
            "window_s": list(window), "settings": settings,
            "settings_flat": {k: v for k, v in flatten(settings).items()

@@ -14,19 +14,55 @@ import numpy as np
 
 from demfem import _core
 from demfem.cartridge import Cartridge
-from demfem.errors import InvalidParameterError, check_positive, check_range
+from demfem.errors import InvalidParameterError, check_count, check_positive, check_range
 
 #: Meshes larger than this are refused unless ``max_elements`` is raised explicitly.
 DEFAULT_MAX_ELEMENTS = 2_000_000
 
 
+def _nodes(field_name: str, nodes: object) -> np.ndarray:
+    try:
+        a = np.asarray(nodes, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidParameterError(f"invalid {field_name}: must be (N, 3) coordinates in m, "
+                                    "numbers") from None
+    if a.ndim != 2 or a.shape[1] != 3:
+        raise InvalidParameterError(f"invalid {field_name}: shape {a.shape}; must be (N, 3) "
+                                    "coordinates in m")
+    return a
+
+
+def _indices(field_name: str, value: object, width: int, n_nodes: int) -> np.ndarray:
+    """Node indices (E, width) of an integer dtype, each in [0, n_nodes); a float, boolean or
+    other array is refused (a float index would be truncated to another node)."""
+    a = np.asarray(value)
+    if a.dtype == bool or not np.issubdtype(a.dtype, np.integer):
+        raise InvalidParameterError(
+            f"invalid {field_name}: dtype {a.dtype}; must be integer node indices (an array of "
+            "an integer dtype, e.g. numpy.int64: non-integer indices are not truncated "
+            "silently)")
+    if a.ndim != 2 or a.shape[1] != width:
+        raise InvalidParameterError(f"invalid {field_name}: shape {a.shape}; must be (E, "
+                                    f"{width}) node indices")
+    if a.size and (a.min() < 0 or a.max() >= n_nodes):
+        k = int(np.flatnonzero(((a < 0) | (a >= n_nodes)).any(axis=1))[0])
+        raise InvalidParameterError(f"invalid {field_name}: element {k} = {a[k].tolist()} "
+                                    f"has node indices outside [0, {n_nodes})")
+    return a
+
+
 @dataclass(frozen=True)
 class TetMesh:
-    """Linear tetrahedra: ``nodes`` (N, 3) m, ``tets`` (E, 4) node indices, positively
-    oriented."""
+    """Linear tetrahedra: ``nodes`` (N, 3) m, ``tets`` (E, 4) node indices (an integer
+    dtype, each in [0, N)), positively oriented."""
 
     nodes: np.ndarray
     tets: np.ndarray
+
+    def __post_init__(self) -> None:
+        nodes = _nodes("nodes", self.nodes)
+        object.__setattr__(self, "nodes", nodes)
+        object.__setattr__(self, "tets", _indices("tets", self.tets, 4, len(nodes)))
 
     @property
     def n_nodes(self) -> int:
@@ -53,12 +89,18 @@ class TetMesh:
 
 @dataclass(frozen=True)
 class ShellMesh:
-    """Flat shell triangles on the mid-surface: ``nodes`` (N, 3) m, ``triangles`` (T, 3),
-    ``thickness`` (T,) m."""
+    """Flat shell triangles on the mid-surface: ``nodes`` (N, 3) m, ``triangles`` (T, 3)
+    node indices (an integer dtype, each in [0, N)), ``thickness`` (T,) m."""
 
     nodes: np.ndarray
     triangles: np.ndarray
     thickness: np.ndarray
+
+    def __post_init__(self) -> None:
+        nodes = _nodes("nodes", self.nodes)
+        object.__setattr__(self, "nodes", nodes)
+        object.__setattr__(self, "triangles",
+                           _indices("triangles", self.triangles, 3, len(nodes)))
 
     @property
     def n_nodes(self) -> int:
@@ -100,14 +142,26 @@ def _layers(layers: int) -> int:
     return int(layers)
 
 
+#: Most divisions around a revolved mesh.
+MAX_N_THETA = 4096
+
+
 def _sizes(cartridge: Cartridge, layers: int, target_size: Optional[float],
            n_theta: Optional[int]) -> tuple[float, int]:
     t = cartridge.wall_thickness
     h = 2.0 * t / layers if target_size is None else check_positive("target_size", target_size)
     if n_theta is None:
-        n_theta = max(12, int(math.ceil(2 * math.pi * 0.5 * cartridge.body_outer_diameter / h)))
-    if isinstance(n_theta, bool) or not isinstance(n_theta, (int, np.integer)) or not 6 <= n_theta <= 4096:
-        raise InvalidParameterError(f"invalid n_theta = {n_theta!r}: must be an integer in [6, 4096]")
+        around = 2 * math.pi * 0.5 * cartridge.body_outer_diameter
+        n_theta = max(12, int(math.ceil(around / h)))
+        if n_theta > MAX_N_THETA:
+            raise InvalidParameterError(
+                f"invalid target_size = {target_size!r} m: the circumference {around:.4g} m "
+                f"would need n_theta = {n_theta} divisions around, more than {MAX_N_THETA}; "
+                f"target_size must be at least {around / MAX_N_THETA:.3g} m")
+    if isinstance(n_theta, bool) or not isinstance(n_theta, (int, np.integer)) \
+            or not 6 <= n_theta <= MAX_N_THETA:
+        raise InvalidParameterError(f"invalid n_theta = {n_theta!r}: must be an integer in "
+                                    f"[6, {MAX_N_THETA}]")
     return h, int(n_theta)
 
 
@@ -142,15 +196,28 @@ def cartridge_tet_mesh(cartridge: Cartridge, layers: int = 2, target_size: Optio
     return TetMesh(np.asarray(nodes), np.asarray(tets))
 
 
+def estimated_shell_count(z: np.ndarray, n_theta: int, target_size: float) -> int:
+    """Triangles the revolved shell mesher makes from the profile stations ``z`` (m): two
+    per cell of n_theta around by the axial divisions of each station interval (at most
+    ``target_size`` long, at least one)."""
+    gaps = np.diff(np.asarray(z, float))
+    axial = np.maximum(1.0, np.ceil(gaps / target_size))
+    return int(2 * n_theta * float(np.sum(axial)))
+
+
 def cartridge_shell_mesh(cartridge: Cartridge, target_size: Optional[float] = None,
                          n_theta: Optional[int] = None,
-                         min_station_gap: float = 0.0) -> ShellMesh:
+                         min_station_gap: float = 0.0,
+                         max_elements: int = DEFAULT_MAX_ELEMENTS) -> ShellMesh:
     """Mid-surface triangle mesh of ``cartridge`` with the wall thickness per triangle.
 
     ``min_station_gap`` (m): profile stations closer than this to the previous kept one are
     dropped (never the ends), e.g. the 0.3 mm crimp step, whose ring of thin triangles
-    would set the explicit step; the profile between the kept stations is linear."""
+    would set the explicit step; the profile between the kept stations is linear. Meshes
+    whose element count (:func:`estimated_shell_count`) exceeds ``max_elements`` are refused
+    before any memory is spent."""
     h, n_theta = _sizes(cartridge, 1, target_size, n_theta)
+    max_elements = check_count("max_elements", max_elements, 1)
     z, ri, ro = cartridge.stations()
     gap = check_range("min_station_gap", min_station_gap, 0.0, math.inf, lo_open=False)
     if gap > 0 and len(z) > 2:
@@ -162,6 +229,13 @@ def cartridge_shell_mesh(cartridge: Cartridge, target_size: Optional[float] = No
             keep.pop()
         keep.append(len(z) - 1)
         z, ri, ro = z[keep], ri[keep], ro[keep]
+    est = estimated_shell_count(z, n_theta, h)
+    if est > max_elements:
+        raise InvalidParameterError(
+            f"invalid target_size = {h:g} m: the shell mesh would have {est} triangles "
+            f"(n_theta = {n_theta} around, {cartridge.length:g} m long), more than "
+            f"max_elements = {max_elements}; raise target_size (or lower n_theta), or raise "
+            "max_elements explicitly")
     nodes, tri, th = _core.fem_shell_mesh(z, ri, ro, n_theta, h)
     return ShellMesh(np.asarray(nodes), np.asarray(tri), np.asarray(th))
 

@@ -9,7 +9,9 @@ two-sided faces offset by half the thickness, penalty s·E·t). All quantities a
 """
 from __future__ import annotations
 
+import hashlib
 import math
+import struct
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Optional, Sequence, Union
@@ -17,7 +19,7 @@ from typing import Any, Callable, Optional, Sequence, Union
 import numpy as np
 
 from demfem import _core
-from demfem.errors import InvalidParameterError, check_positive, check_range
+from demfem.errors import InvalidParameterError, check_count, check_positive, check_range
 from demfem.fem.mesh import ShellMesh, TetMesh
 from demfem.fem.result import FemResult, Snapshot
 from demfem.materials import Material
@@ -32,6 +34,20 @@ def _vec3(field_name: str, v: Sequence[float]) -> tuple[float, float, float]:
 
 def _friction(mu: float) -> float:
     return check_range("friction", mu, 0.0, math.inf, lo_open=False)
+
+
+#: The most steps one run may take (and the largest step count any option may name).
+MAX_STEPS = 2_000_000_000
+
+
+def _step_count(field_name: str, value: Any, lo: int) -> int:
+    """``value`` as a whole number of steps in [lo, MAX_STEPS], else InvalidParameterError
+    naming the field and the limit (never a raw OverflowError from the core)."""
+    n = check_count(field_name, value, lo)
+    if n > MAX_STEPS:
+        raise InvalidParameterError(f"invalid {field_name} = {value!r}: must be a whole number "
+                                    f"of steps in [{lo}, {MAX_STEPS}]")
+    return n
 
 
 @dataclass(frozen=True)
@@ -125,6 +141,9 @@ class ContactOptions:
     contacts_per_node: float = 1.0
     initial_overlap_tolerance: float = 1e-9
     output_interval: int = 10
+
+    def __post_init__(self) -> None:
+        _step_count("output_interval", self.output_interval, 1)
 
 
 ProgressArg = Union[bool, Callable[[int, float], None], None]
@@ -321,11 +340,11 @@ class FemModel:
         check_positive("duration", duration)
         dt = self.dt_step
         n_total = int(math.ceil(duration / dt))
-        if n_total > 2_000_000_000:
+        if n_total > MAX_STEPS:
             raise InvalidParameterError(
-                f"invalid duration = {duration!r}: {n_total} steps of {dt:g} s is beyond 2e9 steps")
-        every = int(sample_every) if sample_every else int(self.contact.output_interval)
-        every = max(1, every)
+                f"invalid duration = {duration!r}: {n_total} steps of {dt:g} s is beyond "
+                f"{MAX_STEPS} steps")
+        every = _step_count("sample_every", sample_every, 0) or int(self.contact.output_interval)
         snaps = sorted(float(t) for t in snapshot_times)
         energy_rows: list[list[float]] = []
         snapshots: list[Snapshot] = []
@@ -370,17 +389,30 @@ class FemModel:
 
     def save_state(self, path: Union[str, Path]) -> Path:
         """Write the run's exact state (displacements, velocities, integrator and contact
-        memory, energies, contact history) to ``path``, atomically. A model built from the
-        same inputs and given :meth:`restore_state` continues bitwise as this one would."""
+        memory, energies, contact history) to ``path``, atomically, behind a header with its
+        length and SHA-256 (:data:`STATE_MAGIC`). A model built from the same inputs and given
+        :meth:`restore_state` continues bitwise as this one would."""
         from demfem.io.atomic import write_bytes_atomic
 
-        return write_bytes_atomic(path, bytes(self._solver.save_state()))
+        return write_bytes_atomic(path, _wrap_state(bytes(self._solver.save_state())))
 
     def restore_state(self, path: Union[str, Path]) -> None:
-        """Restore a state written by :meth:`save_state`. A state of another model (other
-        mesh, step, contact or springs) raises :class:`demfem.errors.ShapeError` and leaves
-        this model unchanged."""
-        self._solver.restore_state(Path(path).read_bytes())
+        """Restore a state written by :meth:`save_state`. A damaged file (truncated, a byte
+        changed, not a state file) raises :class:`demfem.errors.CheckpointError` naming it; a
+        state of another model (other mesh, step, contact or springs)
+        :class:`demfem.errors.ShapeError`; either way this model is left unchanged."""
+        from demfem.errors import DemfemError, DemfemIOError
+
+        path = Path(path)
+        try:
+            data = path.read_bytes()
+        except OSError as exc:
+            raise DemfemIOError(f"i/o error on {path}: {exc.strerror or exc}") from None
+        payload = _unwrap_state(data, path)
+        try:
+            self._solver.restore_state(payload)
+        except DemfemError as exc:
+            raise type(exc)(f"the FEM state {path} does not fit this model: {exc}") from None
 
     def snapshot(self) -> Snapshot:
         """The state now: displacement (N,3) m, element σ1 (E,) Pa, contact pressure (N,) Pa
@@ -415,3 +447,42 @@ class FemModel:
                            "sigma1_top": s[:, 2], "thickness": mesh.thickness})
             return
         self._solver.write_vtu(Path(path))
+
+
+#: Header of a state file of :meth:`FemModel.save_state`: this magic, the format (u32), the
+#: payload's length (u64) and SHA-256 (32 bytes), then the solver's own state bytes.
+STATE_MAGIC = b"DEMFEMCK"
+_STATE_FORMAT = 1
+_STATE_HEADER = struct.Struct("<8sIQ32s")
+
+
+def _wrap_state(payload: bytes) -> bytes:
+    return _STATE_HEADER.pack(STATE_MAGIC, _STATE_FORMAT, len(payload),
+                              hashlib.sha256(payload).digest()) + payload
+
+
+def _unwrap_state(data: bytes, path: Path) -> bytes:
+    """The solver's state bytes of a state file, after checking its header, length and
+    SHA-256; :class:`CheckpointError` naming ``path`` otherwise."""
+    from demfem.errors import CheckpointError
+
+    def damaged(why: str) -> CheckpointError:
+        return CheckpointError(f"damaged FEM state file {path}: {why}; it cannot be restored: "
+                               "start the run afresh (fresh=True, --fresh on the command line)")
+
+    if len(data) < _STATE_HEADER.size or data[:8] != STATE_MAGIC:
+        if data[:8] == b"DEMFEMST":
+            raise damaged("a state of an earlier demfem version, without the checksum this "
+                          "one needs")
+        raise damaged(f"not a demfem FEM state file ({len(data)} bytes, no "
+                      f"{STATE_MAGIC.decode()} header)")
+    _, fmt, length, digest = _STATE_HEADER.unpack_from(data)
+    if fmt != _STATE_FORMAT:
+        raise damaged(f"state file format {fmt}, this version reads {_STATE_FORMAT}")
+    payload = data[_STATE_HEADER.size:]
+    if len(payload) != length:
+        raise damaged(f"{len(payload)} bytes of state where its header says {length} "
+                      "(truncated or extended)")
+    if hashlib.sha256(payload).digest() != digest:
+        raise damaged("its SHA-256 differs from the one in its header (a byte changed)")
+    return payload

@@ -14,17 +14,22 @@ Example::
 from __future__ import annotations
 
 import struct
+import warnings
 from pathlib import Path
 
 import numpy as np
 
-from demfem.errors import DemfemIOError, InvalidParameterError, check_positive
+from demfem.errors import DemfemIOError, DemfemWarning, InvalidParameterError, check_positive
 
 __all__ = ["read_stl", "read_mesh", "write_stl", "weld_vertices", "check_mesh",
-           "open_edge_count"]
+           "open_edge_count", "drop_duplicate_triangles", "MAX_COORDINATE"]
 
 _BINARY_HEADER = 80
 _BINARY_RECORD = 50
+
+#: Largest coordinate of a mesh, m (after ``scale``): a table lies within 100 km of its
+#: origin (the DEM refuses a wider scene); more is a wrong unit or a broken export.
+MAX_COORDINATE = 1e5
 
 
 def _io_error(path: Path, detail: str) -> DemfemIOError:
@@ -50,12 +55,50 @@ def read_stl(path: str | Path, *, scale: float = 1.0,
     if corners.shape[0] == 0:
         raise InvalidParameterError(f"invalid mesh file {path}: it holds no triangles")
     corners = corners.astype(np.float64) * scale
-    if not np.all(np.isfinite(corners)):
-        t = int(np.flatnonzero(~np.all(np.isfinite(corners), axis=(1, 2)))[0])
+    _check_coordinates(corners, path, scale)
+    vertices, triangles = weld_vertices(corners.reshape(-1, 3), weld_tolerance)
+    return vertices, drop_duplicate_triangles(triangles.reshape(-1, 3), str(path))
+
+
+def _check_coordinates(corners: np.ndarray, path: Path, scale: float) -> None:
+    """Refuse non-finite corners and coordinates beyond :data:`MAX_COORDINATE` (after
+    ``scale``), naming the file, the triangle and the scale."""
+    corners = corners.reshape(-1, 3, 3)
+    finite = np.all(np.isfinite(corners), axis=(1, 2))
+    if not np.all(finite):
+        t = int(np.flatnonzero(~finite)[0])
         raise InvalidParameterError(
             f"invalid mesh file {path}: triangle {t} has non-finite coordinates")
-    vertices, triangles = weld_vertices(corners.reshape(-1, 3), weld_tolerance)
-    return vertices, triangles.reshape(-1, 3)
+    far = np.max(np.abs(corners), axis=(1, 2))
+    if far.size and float(far.max()) > MAX_COORDINATE:
+        t = int(np.argmax(far))
+        raise InvalidParameterError(
+            f"invalid mesh file {path}: coordinates up to {float(far[t]):.3g} m (triangle "
+            f"{t}, with scale = {scale:g}); a table's walls must lie within "
+            f"{MAX_COORDINATE:g} m of the origin: is the unit right? (scale converts the "
+            "file's unit to metres: 1e-3 for millimetres)")
+
+
+def drop_duplicate_triangles(triangles: np.ndarray, source: str) -> np.ndarray:
+    """``triangles`` without repeats: a triangle on the same three (welded) vertices as an
+    earlier one, in either orientation, is dropped with a :class:`~demfem.errors.
+    DemfemWarning` naming ``source`` and the count. A face exported twice (two coincident
+    bodies, a face of each) would otherwise be a wall of twice the contact stiffness."""
+    t = np.asarray(triangles)
+    if len(t) < 2:
+        return t
+    _, first = np.unique(np.sort(t, axis=1), axis=0, return_index=True)
+    if len(first) == len(t):
+        return t
+    keep = np.zeros(len(t), bool)
+    keep[first] = True
+    dropped = np.flatnonzero(~keep)
+    warnings.warn(
+        f"mesh {source}: {len(dropped)} of its {len(t)} triangles repeat an earlier one (the "
+        f"first: triangle {int(dropped[0])}); the repeats were dropped, so each face acts once "
+        "(a face twice would press twice as hard); remove them from the CAD export to silence "
+        "this warning", DemfemWarning, stacklevel=3)
+    return t[keep]
 
 
 def _stl_corners(data: bytes, path: Path) -> np.ndarray:
@@ -136,9 +179,15 @@ def read_mesh(path: str | Path, *, scale: float = 1.0,
         raise InvalidParameterError(f"invalid mesh file {path}: it holds no triangles")
     if points.shape[1] == 2:
         points = np.column_stack([points, np.zeros(len(points))])
-    corners = points[np.asarray(cells, np.int64)] * scale
+    cells = np.asarray(cells)
+    if not np.issubdtype(cells.dtype, np.integer) or cells.ndim != 2 or cells.shape[1] != 3 \
+            or cells.min() < 0 or cells.max() >= len(points):
+        raise InvalidParameterError(f"invalid mesh file {path}: its triangles are not (M, 3) "
+                                    f"integer indices into its {len(points)} points")
+    corners = points[cells.astype(np.int64)] * scale
+    _check_coordinates(corners, path, scale)
     vertices, triangles = weld_vertices(corners.reshape(-1, 3), weld_tolerance)
-    return vertices, triangles.reshape(-1, 3)
+    return vertices, drop_duplicate_triangles(triangles.reshape(-1, 3), str(path))
 
 
 def weld_vertices(points: np.ndarray,
@@ -151,6 +200,11 @@ def weld_vertices(points: np.ndarray,
     from scipy.spatial import cKDTree
 
     points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    if not np.all(np.isfinite(points)) or (
+            len(points) and float(np.max(np.abs(points))) > 1e150):
+        raise InvalidParameterError(
+            "invalid points to weld: coordinates must be finite and at most 1e150 m (got up "
+            f"to {float(np.max(np.abs(points))):.3g}); is the unit right?")
     if tolerance is None:
         size = float(np.linalg.norm(points.max(axis=0) - points.min(axis=0))) if len(points) else 0.0
         tolerance = 1e-9 * size
@@ -197,6 +251,14 @@ def check_mesh(vertices: np.ndarray, triangles: np.ndarray, *, source: str,
     (an edge not shared by exactly two triangles)."""
     v = np.asarray(vertices, float)
     t = np.asarray(triangles)
+    if v.ndim != 2 or v.shape[1] != 3 or not np.all(np.isfinite(v)) or (
+            len(v) and float(np.max(np.abs(v))) > MAX_COORDINATE):
+        raise InvalidParameterError(
+            f"invalid mesh {source}: vertices must be (N, 3) finite coordinates within "
+            f"{MAX_COORDINATE:g} m of the origin (is the unit right?)")
+    if t.dtype == bool or not np.issubdtype(t.dtype, np.integer):
+        raise InvalidParameterError(f"invalid mesh {source}: triangles must be integer vertex "
+                                    f"indices, got dtype {t.dtype}")
     if t.ndim != 2 or t.shape[1] != 3 or len(t) == 0:
         raise InvalidParameterError(f"invalid mesh {source}: triangles must be (M, 3), M >= 1, "
                                     f"got shape {t.shape}")

@@ -15,7 +15,7 @@ from typing import Any, Callable, Optional
 
 import numpy as np
 
-__all__ = ["dumps", "finite_or_none", "read_record", "write_json_atomic"]
+__all__ = ["dumps", "finite_or_none", "write_json_atomic"]
 
 
 def finite_or_none(obj: Any, default: Optional[Callable[[Any], Any]] = None) -> Any:
@@ -54,26 +54,3 @@ def write_json_atomic(path: str | Path, obj: Any, indent: Optional[int] = 1,
     from demfem.io.atomic import write_text_atomic
 
     return write_text_atomic(path, dumps(obj, default, indent=indent) + "\n")
-
-
-def read_record(path: str | Path, required: tuple[str, ...], fresh: bool, what: str,
-                command: str) -> Optional[dict]:
-    """A JSON record of a resumable job (``path``; a dict with the keys ``required``), or
-    None when there is none. A damaged one raises :class:`demfem.errors.CheckpointError`
-    naming the file (``what``: e.g. "run record") and how to start afresh (``command``),
-    unless ``fresh``, when it is ignored (None)."""
-    from demfem.errors import CheckpointError
-
-    path = Path(path)
-    if not path.exists():
-        return None
-    try:
-        record = json.loads(path.read_text(encoding="utf-8"))
-        if not isinstance(record, dict) or not set(required) <= set(record):
-            raise ValueError("missing " + " or ".join(repr(k) for k in required))
-    except (OSError, UnicodeDecodeError, ValueError) as exc:
-        if not fresh:
-            raise CheckpointError(f"damaged {what} {path}: {exc}; start afresh (fresh=True, "
-                                  f"{command} --fresh)") from None
-        return None
-    return record

@@ -17,10 +17,22 @@ def read_toml(path: str | Path) -> dict[str, Any]:
     :class:`DemfemIOError`, invalid TOML :class:`InvalidParameterError`, both naming it."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        data = path.read_bytes()
     except OSError as exc:
         raise DemfemIOError(f"i/o error on {path}: {exc.strerror or exc}") from None
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise InvalidParameterError(
+            f"invalid scene file {path}: not UTF-8 text (byte 0x{data[exc.start]:02x} at "
+            f"position {exc.start}); a scene file is TOML text — is it the right file?") from None
+    if "\x00" in text:
+        raise InvalidParameterError(
+            f"invalid scene file {path}: it holds a NUL byte (position {text.index(chr(0))}): "
+            "a binary file, not TOML text — is it the right file?")
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise InvalidParameterError(f"invalid TOML in {path}: {exc}") from None
+    except RecursionError:
+        raise InvalidParameterError(f"invalid TOML in {path}: nested too deeply") from None

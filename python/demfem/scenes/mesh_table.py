@@ -39,7 +39,7 @@ from demfem.materials import PAPER_GLASS
 
 __all__ = ["MeshTable", "MeshSpec", "Belt", "Infeed", "SCENE_NAME", "belt_floor",
            "check_belt_overlaps", "check_belt_seams", "max_infeed_rate", "extrude_polyline",
-           "table_walls_as_mesh"]
+           "table_walls_as_mesh", "check_physical_sense", "memory_limit"]
 
 #: Name of this scene in scene files (the key ``scene``).
 SCENE_NAME = "mesh_table"
@@ -50,7 +50,21 @@ _MATERIAL_KEYS = ("young_modulus", "poisson_ratio", "density", "friction", "rest
 _DEFAULT_EFFECTS = ("gravity", "belt", "friction", "rotation", "damping")
 
 
-def _vec(field_name: str, value: Any, n: int) -> np.ndarray:
+#: Largest coordinate of a scene, m (as a mesh file's, :data:`demfem.io.stl.MAX_COORDINATE`).
+MAX_COORDINATE = 1e5
+#: Largest speed of a belt, an arriving cartridge or a moving wall, m/s.
+MAX_SPEED = 100.0
+#: Most inlet sites, steadiness windows and engine threads a scene may ask for.
+MAX_SITES, MAX_WINDOWS, MAX_THREADS = 100_000, 100_000, 1024
+#: Memory of one sphere of the pool, bytes (engine state, neighbour lists and the runner's
+#: arrays: 550 B measured at 2e5 spheres, 950 B at the peak of the build; rounded up).
+POOL_BYTES_PER_SPHERE = 1000
+#: Deepest static overlap of a resting sphere on the belt under its weight (Hertz), as a
+#: fraction of its radius: deeper, the glass is too soft to stand on the belt.
+MAX_REST_OVERLAP = 0.1
+
+
+def _vec(field_name: str, value: Any, n: int, bound: float = math.inf) -> np.ndarray:
     try:
         a = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
@@ -59,10 +73,16 @@ def _vec(field_name: str, value: Any, n: int) -> np.ndarray:
     if a.shape != (n,) or not np.all(np.isfinite(a)):
         raise InvalidParameterError(
             f"invalid {field_name} = {value!r}: must be {n} finite numbers")
+    if np.any(np.abs(a) > bound):
+        raise InvalidParameterError(
+            f"invalid {field_name} = {a.tolist()}: each component must be within ±{bound:g}")
     return a
 
 
 def _keys(table: Mapping[str, Any], allowed: tuple[str, ...], where: str) -> None:
+    if not isinstance(table, Mapping):
+        raise InvalidParameterError(f"invalid {where} = {table!r}: must be a table "
+                                    f"{{key = value, ...}}, not a {type(table).__name__}")
     for key in table:
         if key not in allowed:
             raise InvalidParameterError(
@@ -86,14 +106,14 @@ def _motion(value: Any, where: str) -> dict[str, Any]:
             raise InvalidParameterError(f"invalid {where}.direction = {d.tolist()}: "
                                         "must be a non-zero vector")
         return {"kind": "harmonic", "direction": d / np.linalg.norm(d),
-                "amplitude": check_range(f"{where}.amplitude", value.get("amplitude", 0.0),
-                                         0.0, math.inf, lo_open=False),
+                "amplitude": check_range(f"{where}.amplitude (m)", value.get("amplitude", 0.0),
+                                         0.0, MAX_COORDINATE, lo_open=False, hi_open=False),
                 "period": check_positive(f"{where}.period", value.get("period", 1.0)),
                 "phase": check_range(f"{where}.phase", value.get("phase", 0.0))}
     if kind == "constant":
         _keys(value, ("kind", "velocity"), where)
         return {"kind": "constant",
-                "velocity": _vec(f"{where}.velocity", value.get("velocity"), 3)}
+                "velocity": _vec(f"{where}.velocity", value.get("velocity"), 3, MAX_SPEED)}
     if kind == "rotation":
         _keys(value, ("kind", "axis_point", "axis", "angular_velocity"), where)
         axis = _vec(f"{where}.axis", value.get("axis", (0.0, 0.0, 1.0)), 3)
@@ -101,7 +121,8 @@ def _motion(value: Any, where: str) -> dict[str, Any]:
             raise InvalidParameterError(f"invalid {where}.axis = {axis.tolist()}: must be a "
                                         "non-zero vector")
         return {"kind": "rotation",
-                "axis_point": _vec(f"{where}.axis_point", value.get("axis_point"), 3),
+                "axis_point": _vec(f"{where}.axis_point", value.get("axis_point"), 3,
+                                   MAX_COORDINATE),
                 "axis": axis / np.linalg.norm(axis),
                 "angular_velocity": check_range(f"{where}.angular_velocity (rad/s)",
                                                 value.get("angular_velocity"))}
@@ -136,6 +157,9 @@ class MeshSpec:
         if "file" not in d:
             raise InvalidParameterError(f"invalid {where}: 'file' (the mesh's path, relative "
                                         "to the scene file) is required")
+        if not isinstance(d["file"], str) or not d["file"]:
+            raise InvalidParameterError(f"invalid {where}.file = {d['file']!r}: must be the "
+                                        "mesh file's path (a string)")
         path = Path(d["file"])
         path = path if path.is_absolute() else base / path
         scale = check_positive(f"{where}.scale", d.get("scale", 1.0))
@@ -149,7 +173,8 @@ class MeshSpec:
                    triangles=triangles, scale=scale, material=str(d.get("material", "glass")),
                    closed=closed, motion=_motion(d.get("motion"), f"{where}.motion"),
                    surface_velocity=_vec(f"{where}.surface_velocity",
-                                         d.get("surface_velocity", (0.0, 0.0, 0.0)), 3))
+                                         d.get("surface_velocity", (0.0, 0.0, 0.0)), 3,
+                                         MAX_SPEED))
 
 
 @dataclass(frozen=True, eq=False)
@@ -171,10 +196,10 @@ class Belt:
         except (TypeError, ValueError):
             poly = np.zeros((0,))
         if poly.ndim != 2 or poly.shape[1] != 2 or len(poly) < 3 or not np.all(
-                np.isfinite(poly)):
+                np.isfinite(poly)) or np.any(np.abs(poly) > MAX_COORDINATE):
             raise InvalidParameterError(
                 f"invalid {where}.polygon = {d.get('polygon')!r}: must be at least 3 finite "
-                "[x, y] corners (m) of a convex polygon")
+                f"[x, y] corners (m, within ±{MAX_COORDINATE:g}) of a convex polygon")
         area2 = _cross_sum(poly)
         if not abs(area2) > 0:
             raise InvalidParameterError(f"invalid {where}.polygon: zero area")
@@ -187,7 +212,8 @@ class Belt:
             raise InvalidParameterError(f"invalid {where}.polygon: must be convex, corners in "
                                         "boundary order")
         return cls(name=str(d.get("name", f"belt{k}")), polygon=poly,
-                   velocity=_vec(f"{where}.velocity", d.get("velocity", (0.0, 0.0)), 2),
+                   velocity=_vec(f"{where}.velocity", d.get("velocity", (0.0, 0.0)), 2,
+                                 MAX_SPEED),
                    material=str(d.get("material", "glass")))
 
 
@@ -284,12 +310,15 @@ class Infeed:
             region = np.asarray(d.get("region"), dtype=float)
         except (TypeError, ValueError):
             region = np.zeros(0)
-        if region.shape != (2, 2) or not np.all(np.isfinite(region)):
+        if region.shape != (2, 2) or not np.all(np.isfinite(region)) or np.any(
+                np.abs(region) > MAX_COORDINATE):
             raise InvalidParameterError(
                 f"invalid infeed.region = {d.get('region')!r} in {source}: must be "
-                "[[x0, y0], [x1, y1]] (m), two corners of a rectangle on the floor")
+                "[[x0, y0], [x1, y1]] (m), two corners of a rectangle on the floor (within "
+                f"±{MAX_COORDINATE:g} m)")
         region = np.sort(region, axis=0)
-        velocity = _vec(f"infeed.velocity in {source}", d.get("velocity", (0.0, 0.0)), 2)
+        velocity = _vec(f"infeed.velocity in {source}", d.get("velocity", (0.0, 0.0)), 2,
+                        MAX_SPEED)
         if not np.linalg.norm(velocity) > 0:
             raise InvalidParameterError(
                 f"invalid infeed.velocity = {velocity.tolist()} in {source}: must be non-zero "
@@ -306,6 +335,11 @@ class Infeed:
             return np.zeros((0, 3))
         nx = int(math.floor((hi[0] - lo[0]) / pitch)) + 1
         ny = int(math.floor((hi[1] - lo[1]) / pitch)) + 1
+        if nx * ny > MAX_SITES:
+            raise InvalidParameterError(
+                f"invalid infeed.region = {self.region.tolist()} m: {nx * ny} inlet sites of "
+                f"pitch {pitch:.3g} m, more than {MAX_SITES}; an inlet is a strip along the "
+                "belt's width, not the whole table")
         xs = lo[0] + 0.5 * (hi[0] - lo[0] - (nx - 1) * pitch) + pitch * np.arange(nx)
         ys = lo[1] + 0.5 * (hi[1] - lo[1] - (ny - 1) * pitch) + pitch * np.arange(ny)
         gx, gy = np.meshgrid(xs, ys, indexing="ij")
@@ -388,6 +422,13 @@ class MeshTable:
         materials = {"glass": {"young_modulus": PAPER_GLASS.E, "poisson_ratio": PAPER_GLASS.nu,
                                "density": PAPER_GLASS.density, "friction": 0.2,
                                "restitution": 0.5, "rolling_resistance": 0.0}}
+        if not isinstance(d.get("materials", {}), Mapping):
+            raise InvalidParameterError(f"invalid materials in {source}: must be tables "
+                                        "[materials.NAME]")
+        for key in ("meshes", "belts"):
+            if not isinstance(d.get(key, []), list):
+                raise InvalidParameterError(f"invalid {key} in {source}: must be a list of "
+                                            f"tables [[{key}]]")
         for name, m in (d.get("materials") or {}).items():
             where = f"materials.{name} of {source}"
             if not isinstance(m, Mapping):
@@ -452,6 +493,10 @@ class MeshTable:
         out = {"point": _vec(f"outlet.point in {source}", outlet.get("point"), 3),
                "normal": normal / np.linalg.norm(normal)}
         effects = d.get("effects")
+        if effects is not None and (not isinstance(effects, list) or not all(
+                isinstance(e, str) for e in effects)):
+            raise InvalidParameterError(f"invalid effects = {effects!r} in {source}: must be "
+                                        "a list of effect names, e.g. [\"gravity\", \"belt\"]")
         if effects is None:
             effects = list(_DEFAULT_EFFECTS)
             if any(m.motion["kind"] != "fixed" for m in meshes):
@@ -466,18 +511,24 @@ class MeshTable:
         if model not in CONTACT_MODELS:
             raise InvalidParameterError(f"invalid model = {model!r} in {source}: must be one "
                                         f"of {CONTACT_MODELS}")
-        return cls(meshes=meshes, belts=belts, infeed=infeed, outlet=out, materials=materials,
-                   particle_material=pm, sphere_radius=radius,
-                   pool=check_count(f"particles.pool in {source}", particles.get("pool", 600),
-                                    lo=1),
-                   packing_gap=gap, effects=tuple(str(e) for e in effects), model=model,
-                   duration=duration,
-                   window=check_range(f"window (s) in {source}", d.get("window", duration / 10),
-                                      0.0, duration, hi_open=False),
-                   lost_below=check_range(f"lost_below (m) in {source}",
-                                          d.get("lost_below", -0.05)),
-                   threads=check_count(f"threads in {source}", d.get("threads", 1), lo=1),
-                   source=source)
+        threads = check_count(f"threads in {source}", d.get("threads", 1), lo=1)
+        if threads > MAX_THREADS:
+            raise InvalidParameterError(f"invalid threads = {threads} in {source}: must be in "
+                                        f"[1, {MAX_THREADS}]")
+        table = cls(meshes=meshes, belts=belts, infeed=infeed, outlet=out, materials=materials,
+                    particle_material=pm, sphere_radius=radius,
+                    pool=check_count(f"particles.pool in {source}", particles.get("pool", 600),
+                                     lo=1),
+                    packing_gap=gap, effects=tuple(effects), model=model,
+                    duration=duration,
+                    window=check_range(f"window (s) in {source}",
+                                       d.get("window", duration / 10), duration / MAX_WINDOWS,
+                                       duration, lo_open=False, hi_open=False),
+                    lost_below=check_range(f"lost_below (m) in {source}",
+                                           d.get("lost_below", -0.05)),
+                    threads=threads, source=source)
+        check_physical_sense(table)
+        return table
 
     # ---- the engine-neutral description ----------------------------------------------------
 
@@ -557,9 +608,104 @@ class MeshTable:
                 "duration_s": self.duration, "window_s": self.window,
                 "effects": list(self.effects), "model": self.model}
 
+    def job_settings(self, duration: float) -> dict[str, Any]:
+        """What makes a run's result, for its output folder's record
+        (:class:`demfem.jobs.OutputFolder`): every field but the mesh arrays and the source
+        path (the mesh files join as inputs by their SHA-256, :meth:`input_files`), and the
+        run's ``duration`` (s). Strict-JSON values."""
+        from demfem.io.strict_json import finite_or_none
+
+        return finite_or_none({
+            "scene": SCENE_NAME, "duration_s": float(duration),
+            "meshes": [{"name": m.name, "scale": m.scale, "material": m.material,
+                        "closed": m.closed, "motion": m.motion,
+                        "surface_velocity": m.surface_velocity} for m in self.meshes],
+            "belts": [{"name": b.name, "polygon": b.polygon, "velocity": b.velocity,
+                       "material": b.material} for b in self.belts],
+            "infeed": {"rate": self.infeed.rate, "region": self.infeed.region,
+                       "velocity": self.infeed.velocity},
+            "outlet": self.outlet, "materials": self.materials,
+            "particle_material": self.particle_material, "sphere_radius": self.sphere_radius,
+            "pool": self.pool, "packing_gap": self.packing_gap, "effects": list(self.effects),
+            "model": self.model, "window": self.window, "lost_below": self.lost_below})
+
+    def input_files(self) -> dict[str, Path]:
+        """The mesh files the table was read from, by the name ``meshes[k]``."""
+        return {f"meshes[{k}]": m.file for k, m in enumerate(self.meshes)}
+
     def replace(self, **changes: Any) -> "MeshTable":
         """A copy with some fields changed (e.g. a shorter ``duration``)."""
         return dataclasses.replace(self, **changes)
+
+
+def check_physical_sense(table: MeshTable) -> None:
+    """Refuse a scene that would run to a meaningless result, naming its file, the field and
+    the limit: the pool's memory above half this machine's (an estimate, before anything is
+    allocated); ``lost_below`` not below the belts; an inlet site off every belt, or on the
+    exit side of the outlet plane (or within a radius of it); glass too soft to stand on the
+    belt (its Hertz rest overlap under its weight above :data:`MAX_REST_OVERLAP` of its
+    radius)."""
+    src, r = table.source, table.sphere_radius
+    need, limit = table.pool * POOL_BYTES_PER_SPHERE, memory_limit()
+    if need > limit:
+        raise InvalidParameterError(
+            f"invalid particles.pool = {table.pool} in {src}: the pool's spheres need about "
+            f"{need / 1e9:.3g} GB of memory ({POOL_BYTES_PER_SPHERE} bytes each), more than "
+            f"the limit of {limit / 1e9:.3g} GB (half this machine's memory); the pool is the "
+            "most cartridges on the table at once: a few thousand at most")
+    if not table.lost_below < 0.0:
+        raise InvalidParameterError(
+            f"invalid lost_below = {table.lost_below!r} m in {src}: must be below the belts "
+            f"(z = 0; a cartridge on a belt has its centre at z = r = {r:.4g} m), e.g. -0.05: "
+            "spheres whose centre falls below it are counted as lost")
+    sites = table.infeed.sites(r, table.packing_gap)
+    for k, site in enumerate(sites):
+        if not any(_inside(b.polygon, site[:2]) for b in table.belts):
+            raise InvalidParameterError(
+                f"invalid infeed.region = {table.infeed.region.tolist()} m in {src}: its "
+                f"inlet site {k} at {site[:2].tolist()} m is not over any belt: a cartridge "
+                "placed there would fall")
+    p, n = table.outlet["point"], table.outlet["normal"]
+    past = (sites - p) @ n
+    if len(past) and float(past.max()) > -r:
+        k = int(np.argmax(past))
+        raise InvalidParameterError(
+            f"invalid outlet in {src}: the inlet site {sites[k].tolist()} m is "
+            f"{'past' if past[k] > 0 else 'within one radius of'} the outlet plane (point "
+            f"{p.tolist()}, normal {n.tolist()}): cartridges would leave as they arrive; the "
+            "outlet is downstream of the inlet, its normal pointing out of the table")
+    glass = table.materials[table.particle_material]
+    belt = table.materials[table.belts[0].material]
+    e_star = 1.0 / sum((1.0 - m["poisson_ratio"] ** 2) / m["young_modulus"]
+                       for m in (glass, belt))
+    rest = (3.0 * table.sphere_mass * 9.81 / (4.0 * e_star * math.sqrt(r))) ** (2.0 / 3.0)
+    if rest > MAX_REST_OVERLAP * r:
+        raise InvalidParameterError(
+            f"invalid materials.{table.particle_material}.young_modulus = "
+            f"{glass['young_modulus']:g} Pa in {src}: a cartridge resting on the belt would "
+            f"sink {rest:.3g} m into it under its own weight (Hertz, against "
+            f"{table.belts[0].material!r} at {belt['young_modulus']:g} Pa), more than "
+            f"{MAX_REST_OVERLAP:g} of its radius {r:.3g} m: it would fall through the belt; "
+            "the glass is far stiffer (45 GPa in the paper; 1e7 Pa is soft enough for fast "
+            "runs)")
+
+
+def memory_limit() -> float:
+    """Half the machine's physical memory, bytes (8 GB where it cannot be read)."""
+    import os
+
+    try:
+        return 0.5 * os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (AttributeError, ValueError, OSError):
+        return 8e9
+
+
+def _inside(polygon: np.ndarray, point: np.ndarray) -> bool:
+    """Whether ``point`` lies in (or on) the convex counter-clockwise ``polygon`` (m)."""
+    edges = np.roll(polygon, -1, axis=0) - polygon
+    rel = point - polygon
+    cross = (edges[:, 0] * rel[:, 1] - edges[:, 1] * rel[:, 0]) / np.linalg.norm(edges, axis=1)
+    return bool(np.all(cross >= -1e-9 * float(np.ptp(polygon, axis=0).max())))
 
 
 def extrude_polyline(xy: Any, height: float, *, spacing: float,

@@ -21,7 +21,7 @@ from typing import Any, Mapping, Optional, Sequence
 
 import numpy as np
 
-from demfem.assess.stress_model import StressModel
+from demfem.stress.stress_model import StressModel
 from demfem.errors import InvalidParameterError, check_count, check_positive
 from demfem.io.strict_json import write_json_atomic
 
@@ -90,7 +90,7 @@ def fit_from_fem(out: str | Path = "demfem_out/stress_model",
             f"{hold_out_every} to hold one back")
     log(f"stress model: {n_points} FEM collisions ({layers} layers, E = {young_modulus:.3g} "
         f"Pa), every {hold_out_every}th held back")
-    result = sweep(grid, "demfem.assess.fem_fit:collision_point", out, scheduler=scheduler,
+    result = sweep(grid, "demfem.stress.fem_fit:collision_point", out, scheduler=scheduler,
                    n_workers=n_workers, fixed=fixed,
                    progress=lambda d, n: log(f"  FEM runs done {d}/{n}"))
     records = sorted(result.records, key=lambda r: run_key(r["params"]))

@@ -41,9 +41,27 @@ Assumptions: linear elastic, thin (t ≪ R) and shallow shell, static (quasi-sta
 the contact lasts ≫ the shell's lowest local bending period), a sphere of the cylinder's
 mid-surface radius standing for the cylindrical body — the same idealisation as the
 calibration's Reissner stiffness; a cylinder, flat in one direction, bends more under a
-point load (refit β from the FEM, :meth:`demfem.assess.StressModel.fit`). The Hertzian
+point load (refit β from the FEM, :meth:`demfem.stress.StressModel.fit`). The Hertzian
 contact's own surface tension at the edge of the contact circle, (1 − 2ν) p_0 / 3 (the
-ring-crack stress), confined to a depth of order the contact radius, is not in this model.
+ring-crack stress), confined to a depth of order the contact radius, is not in this model:
+:func:`demfem.stress.contact_stresses` superposes it.
+
+**The Hertz patch.** The load of a contact is not uniform over the patch but Hertzian,
+p ∝ √(1 − r²/c²). Near the load (r ≪ ℓ) the shell is a thin plate, whose moment field under
+an axisymmetric load follows from the point solution exactly: with s = r/c, the load's
+normalised radial density 3 s √(1 − s²), and
+
+    h(s) = ∫_{s'>s} 3 s' √(1 − s'²) ln(s'/s) ds' = ln((1 + w)/s) − w − w³/3,  w = √(1 − s²)
+    (0 for s ≥ 1),   h̄(s) = (2/s²) ∫_0^s s' h(s') ds'   (= 1/(5 s²) for s ≥ 1),
+
+the patch's moments are (M_r + M_θ) = (M_r + M_θ)_point − (1 + ν)(P/2π) h(s) and
+(M_θ − M_r) = (M_θ − M_r)_point + (1 − ν)(P/2π)(h(s) − h̄(s)) (the Laplacian of the deflection
+averages ln|x − x'| over the load; D(1 − ν)(Λ − Λ̄) gives the difference of the moments).
+Outside the patch this is the point field plus (1 − ν) P ⟨ρ²⟩/(8π r²) on M_r (minus on M_θ),
+⟨ρ²⟩ = 2c²/5; at the centre M_0 = (1 + ν) P/(4π) [ln(ℓ/c) + 4/3 − γ] — the uniform patch's
+constant ln 2 + 1/2 − γ becomes 4/3 − γ (:data:`HERTZ_PATCH_CONSTANT`), since the mean of
+ln(c/ρ) over the Hertz pressure is 4/3 − ln 2 instead of 1/2. :func:`hertz_patch_surface_stresses`
+evaluates this field; the membrane forces are the point solution's (finite at the load).
 
 SI units: m, N, Pa; all coefficients β are dimensionless (σ = β P / t²).
 """
@@ -59,10 +77,17 @@ from scipy.special import kei, keip, ker, kerp
 from demfem.errors import InvalidParameterError, check_positive, check_range
 
 __all__ = ["ShellClosedForm", "characteristic_length", "point_load_surface_stresses",
-           "patch_centre_coefficients", "closed_form_coefficients", "PATCH_CONSTANT"]
+           "patch_centre_coefficients", "closed_form_coefficients", "PATCH_CONSTANT",
+           "HERTZ_PATCH_CONSTANT", "hertz_patch_centre_coefficients",
+           "hertz_patch_surface_stresses", "point_load_deflection", "point_load_resultants"]
+
+_EULER_GAMMA = 0.5772156649015329
 
 #: ln 2 + 1/2 − γ (Euler's γ): the constant of the patch-load moment (Timoshenko § 58).
-PATCH_CONSTANT = math.log(2.0) + 0.5 - 0.5772156649015329
+PATCH_CONSTANT = math.log(2.0) + 0.5 - _EULER_GAMMA
+
+#: 4/3 − γ: the same constant for a Hertzian pressure p ∝ √(1 − r²/c²) (module docstring).
+HERTZ_PATCH_CONSTANT = 4.0 / 3.0 - _EULER_GAMMA
 
 
 def characteristic_length(shell_radius: float, thickness: float, nu: float) -> float:
@@ -77,14 +102,23 @@ def characteristic_length(shell_radius: float, thickness: float, nu: float) -> f
     return math.sqrt(R * t) / (12.0 * (1.0 - nu * nu)) ** 0.25
 
 
-def point_load_surface_stresses(x: np.ndarray, nu: float) -> dict[str, np.ndarray]:
-    """Surface stresses of the shallow-shell point-load solution at r = x ℓ (x > 0), as
-    dimensionless coefficients σ t² / P: keys ``inner_r``, ``inner_theta``, ``outer_r``,
-    ``outer_theta`` and the max principal stresses ``inner_s1``, ``outer_s1``."""
-    x = np.asarray(x, float)
-    if np.any(~np.isfinite(x)) or np.any(x <= 0):
-        raise InvalidParameterError("invalid x: must be finite and > 0 (r / ell)")
-    nu = check_range("nu", nu, -1.0, 0.5)
+def point_load_deflection(r: np.ndarray, force: float, shell_radius: float, thickness: float,
+                          young_modulus: float, nu: float) -> np.ndarray:
+    """Deflection w (m, inward) of the shallow shell under a point ``force`` P (N) at the
+    distances ``r`` (m, ≥ 0): w = −(P ℓ²/(2π D)) kei(r/ℓ), so w(0) = P ℓ²/(8D) = P/k_R with
+    Reissner's stiffness k_R = 4 E t²/(R √(3(1 − ν²))) (module docstring)."""
+    r = np.asarray(r, float)
+    if np.any(~np.isfinite(r)) or np.any(r < 0):
+        raise InvalidParameterError("invalid r: must be finite and >= 0 m")
+    P = check_positive("force", force)
+    E = check_positive("young_modulus", young_modulus)
+    ell = characteristic_length(shell_radius, thickness, nu)
+    D = E * thickness**3 / (12.0 * (1.0 - nu * nu))
+    return -P * ell * ell / (2.0 * math.pi * D) * kei(r / ell)
+
+
+def _point_load_resultants(x: np.ndarray, nu: float) -> tuple[np.ndarray, ...]:
+    """(M_r/P, M_θ/P, N_r t/P, N_θ t/P) of the point-load solution at r = x ℓ (x > 0)."""
     # Kelvin functions: K = ker + i kei solves K'' + K'/x - i K = 0
     kei1, ker1 = keip(x), kerp(x)
     kei2 = ker(x) - kei1 / x
@@ -94,10 +128,86 @@ def point_load_surface_stresses(x: np.ndarray, nu: float) -> dict[str, np.ndarra
     c = math.sqrt(12.0 * (1.0 - nu * nu)) / (2.0 * math.pi)
     n_r = -c * (ker1 + 1.0 / x) / x                    # N_r t / P
     n_t = -c * (ker2 - 1.0 / x**2)                     # N_theta t / P
+    return m_r, m_t, n_r, n_t
+
+
+def _surface(m_r: np.ndarray, m_t: np.ndarray, n_r: np.ndarray,
+             n_t: np.ndarray) -> dict[str, np.ndarray]:
     out = {"inner_r": n_r + 6.0 * m_r, "inner_theta": n_t + 6.0 * m_t,
            "outer_r": n_r - 6.0 * m_r, "outer_theta": n_t - 6.0 * m_t}
     out["inner_s1"] = np.maximum(out["inner_r"], out["inner_theta"])
     out["outer_s1"] = np.maximum(out["outer_r"], out["outer_theta"])
+    return out
+
+
+def point_load_surface_stresses(x: np.ndarray, nu: float) -> dict[str, np.ndarray]:
+    """Surface stresses of the shallow-shell point-load solution at r = x ℓ (x > 0), as
+    dimensionless coefficients σ t² / P: keys ``inner_r``, ``inner_theta``, ``outer_r``,
+    ``outer_theta`` and the max principal stresses ``inner_s1``, ``outer_s1``."""
+    x = np.asarray(x, float)
+    if np.any(~np.isfinite(x)) or np.any(x <= 0):
+        raise InvalidParameterError("invalid x: must be finite and > 0 (r / ell)")
+    nu = check_range("nu", nu, -1.0, 0.5)
+    return _surface(*_point_load_resultants(x, nu))
+
+
+def _hertz_h(s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """h(s) and its disc mean h̄(s) of the Hertz patch (module docstring), s = r/c > 0."""
+    inside = s < 1.0
+    si = np.where(inside, s, 0.5)
+    w = np.sqrt(1.0 - si * si)
+    h = np.where(inside, np.log((1.0 + w) / si) - w - w**3 / 3.0, 0.0)
+    # ∫_0^s s' h ds' = 1/2 − w/2 + (s²/2) ln((1 + w)/s) − (1 − w³)/3 − (1 − w⁵)/15
+    integral = 0.5 - 0.5 * w + 0.5 * si * si * np.log((1.0 + w) / si) - (1.0 - w**3) / 3.0 \
+        - (1.0 - w**5) / 15.0
+    mean = np.where(inside, 2.0 * integral / (si * si), 1.0 / (5.0 * np.where(inside, 1.0, s)**2))
+    return h, mean
+
+
+def hertz_patch_centre_coefficients(ell_over_c: float, nu: float) -> tuple[float, float]:
+    """(inner, outer) σ t² / P at the centre of a Hertzian load of radius c, ``ell_over_c`` =
+    ℓ/c ≥ 1: ±3(1+ν)/(2π) (ln(ℓ/c) + 4/3 − γ) − √(12(1−ν²))/16."""
+    q = check_range("ell_over_c", ell_over_c, 1.0, math.inf, lo_open=False)
+    nu = check_range("nu", nu, -1.0, 0.5)
+    bending = 3.0 * (1.0 + nu) / (2.0 * math.pi) * (math.log(q) + HERTZ_PATCH_CONSTANT)
+    membrane = -math.sqrt(12.0 * (1.0 - nu * nu)) / 16.0
+    return bending + membrane, -bending + membrane
+
+
+def point_load_resultants(x: np.ndarray, nu: float) -> tuple[np.ndarray, ...]:
+    """(M_r/P, M_θ/P, N_r t/P, N_θ t/P) of the point-load solution at r = x ℓ (x > 0): the
+    stress resultants behind :func:`point_load_surface_stresses`."""
+    x = np.asarray(x, float)
+    if np.any(~np.isfinite(x)) or np.any(x <= 0):
+        raise InvalidParameterError("invalid x: must be finite and > 0 (r / ell)")
+    return _point_load_resultants(x, check_range("nu", nu, -1.0, 0.5))
+
+
+def hertz_patch_surface_stresses(x: np.ndarray, x_c: float, nu: float,
+                                 point: tuple[np.ndarray, ...] | None = None
+                                 ) -> dict[str, np.ndarray]:
+    """Surface stresses of the shallow shell under a Hertzian pressure of radius c = x_c ℓ
+    (``x_c`` in (0, 1)) at r = x ℓ (x ≥ 0), as coefficients σ t² / P (module docstring):
+    keys as :func:`point_load_surface_stresses`. Exact for the thin-plate near field; beyond
+    the patch it is the point solution plus the (1 − ν) P ⟨ρ²⟩/(8π r²) correction.
+    ``point``: :func:`point_load_resultants` at these x (all > 0), when already computed."""
+    x = np.asarray(x, float)
+    if np.any(~np.isfinite(x)) or np.any(x < 0):
+        raise InvalidParameterError("invalid x: must be finite and >= 0 (r / ell)")
+    x_c = check_range("x_c", x_c, 0.0, 1.0)
+    nu = check_range("nu", nu, -1.0, 0.5)
+    centre = x < 1e-3 * x_c
+    xs = np.where(centre, x_c, x)
+    m_r, m_t, n_r, n_t = _point_load_resultants(xs, nu) if point is None else point
+    h, hbar = _hertz_h(xs / x_c)
+    m_sum = m_r + m_t - (1.0 + nu) * h / (2.0 * math.pi)
+    m_diff = (m_t - m_r) + (1.0 - nu) * (h - hbar) / (2.0 * math.pi)
+    out = _surface(0.5 * (m_sum - m_diff), 0.5 * (m_sum + m_diff), n_r, n_t)
+    if np.any(centre):
+        inner0, outer0 = hertz_patch_centre_coefficients(1.0 / x_c, nu)
+        for key, value in (("inner", inner0), ("outer", outer0)):
+            for comp in ("_r", "_theta", "_s1"):
+                out[key + comp] = np.where(centre, value, out[key + comp])
     return out
 
 

@@ -12,7 +12,7 @@ Weibull effective areas of the two σ1 fields (A_eff = ∫ (σ1/σ1_max)^m dA, A
 P = 1 − exp(−(A/A_0)(σ1/σ_0)^m) for each surface.
 
 Defaults (:meth:`StressModel.default`, the shipped ``stress_model_default.json``): Reissner's
-shallow-shell point-load solution (:mod:`demfem.assess.closed_form`) for the default 3 mL
+shallow-shell point-load solution (:mod:`demfem.stress.shell`) for the default 3 mL
 cartridge (t = 1.1 mm, mid-surface radius 5.25 mm, ν = 0.22) loaded over the Hertz contact
 patch of a reference collision (two cartridges at 0.05 m/s, E = 45 GPa: F_ref ≈ 3.9 N, a ≈
 80 µm), and the default Weibull moduli (inner 10, outer 6):
@@ -208,7 +208,7 @@ def closed_form_model(young_modulus: float = 45e9, reference_speed: float = REFE
     Reissner's shallow-shell solution loaded over the Hertz patch of two cartridges colliding
     at ``reference_speed`` (m/s) with Young's modulus ``young_modulus`` (Pa); area factors for
     the Weibull moduli ``m_inner`` / ``m_outer`` (default: :mod:`demfem.risk.defaults`)."""
-    from demfem.assess.closed_form import closed_form_coefficients
+    from demfem.stress.shell import closed_form_coefficients
     from demfem.assess.impact import cartridge_body, contact_radius, pair_constants
     from demfem.cartridge import Cartridge
     from demfem.contact import max_contact_force

@@ -19,12 +19,22 @@ runs it (σ1 of cartridge 1 sampled every ``stress_interval`` = 5 µs, since an 
 * ``vtk/cluster_NNNN.vtu`` and ``cluster.pvd``: the VTK series (ParaView);
 * ``summary.json``: peaks, wall time, steps, settings (strict JSON).
 
+The folder (:class:`demfem.jobs.OutputFolder`, record ``settings.json``) is locked while the
+run writes it; another command's folder or other settings are refused unless
+``fresh=True``.
+
 Resume: every ``checkpoint_every`` s of wall time (30 s) the run saves its exact FEM state
-(``checkpoint.state``: displacements, velocities, contact memory, histories) and what it
-has gathered (``checkpoint.npz``), atomically; a rerun with the same settings after an
-interruption (Ctrl-C, kill -9, power loss) restores it and ends with the numbers of an
-uninterrupted run. Once ``run.npz`` is there, a rerun only redoes the figures and files.
-Other settings in the same folder are refused unless ``fresh=True``.
+(``checkpoint.state``: displacements, velocities, contact memory, histories, with its own
+SHA-256, :meth:`demfem.fem.FemModel.save_state`) and what it has gathered
+(``checkpoint.npz``, which names the state's SHA-256: the commit), atomically; a rerun with
+the same settings after an interruption (Ctrl-C, kill -9, power loss) restores it and ends
+with the numbers of an uninterrupted run. Once ``run.npz`` is there (its SHA-256 in the
+record), a rerun only redoes the figures and files. A damaged or altered checkpoint or
+``run.npz`` is refused by name (:class:`~demfem.errors.CheckpointError`, ``--fresh``).
+
+Sanity: a cartridge set to hit 1 within the run that never touched it (a peak contact force
+of 0 N: a Young's modulus so low, or a step so long, that the impact is not resolved) is a
+:class:`~demfem.errors.NumericalError`, not a result.
 """
 from __future__ import annotations
 
@@ -32,15 +42,17 @@ import csv
 import io
 import json
 import math
-import shutil
+import os
 import time as _time
+import zipfile
+import zlib
 from pathlib import Path
 from typing import Any, Callable, Optional, Union
 
 import numpy as np
 
-from demfem.errors import (InvalidParameterError, SettingsMismatchError, SimulationInterrupted,
-                           check_positive)
+from demfem.errors import (CheckpointError, DemfemError, InvalidParameterError,
+                           NumericalError, SimulationInterrupted, check_positive)
 from demfem.io.atomic import atomic_path, savefig_atomic, write_text_atomic
 from demfem.io.strict_json import write_json_atomic
 from demfem.scenes.cluster import SITE_ANGLES_DEG, CartridgeCluster
@@ -67,13 +79,13 @@ def _settings(cluster: CartridgeCluster, duration: float, n_snapshots: int) -> d
                                   "n_snapshots": n_snapshots}))
 
 
-def _diff(a: Any, b: Any, prefix: str = "") -> list[str]:
-    if isinstance(a, dict) and isinstance(b, dict):
-        out = []
-        for k in sorted(set(a) | set(b)):
-            out += _diff(a.get(k), b.get(k), f"{prefix}{k}.")
-        return out
-    return [] if a == b else [f"{prefix[:-1]} ({b!r} there, {a!r} now)"]
+#: The job's name in its folder's record, and the record.
+COMMAND = "demfem cluster"
+_RECORD = "settings.json"
+
+#: What the run writes (glob patterns), checkpoint included: removed by a fresh start.
+OUTPUT_FILES = ("run.npz", "summary.json", "forces.csv", "cluster.pvd", "cluster_*",
+                "vtk/cluster_*.vtu", "checkpoint.*")
 
 
 def run_cluster(cluster: CartridgeCluster, duration: float = 3e-3,
@@ -101,48 +113,88 @@ def run_cluster(cluster: CartridgeCluster, duration: float = 3e-3,
     check_positive("checkpoint_every", checkpoint_every)
     settings = _settings(cluster, duration, n_snapshots)
     settings["stress_interval_s"] = float(stress_interval)
-    settings_path, run_path = out / "settings.json", out / "run.npz"
-    if settings_path.exists() and not fresh:
-        try:
-            old = json.loads(settings_path.read_text())
-        except (OSError, ValueError):
-            old = None
-        if old != settings:
-            diffs = _diff(settings, old) if isinstance(old, dict) else ["settings.json unreadable"]
-            raise SettingsMismatchError(
-                f"{out} holds a cluster run with other settings: {'; '.join(diffs[:5])} "
-                "(use another --out, or --fresh to replace it)")
-    if fresh and out.exists():
-        for name in ("run.npz", "settings.json", "summary.json", "forces.csv", "cluster.pvd",
-                     *_CHECKPOINT):
-            (out / name).unlink(missing_ok=True)
-        for p in out.glob("cluster_*"):
-            p.unlink(missing_ok=True)
-        shutil.rmtree(out / "vtk", ignore_errors=True)
-    out.mkdir(parents=True, exist_ok=True)
-    write_json_atomic(settings_path, settings)
-    if run_path.exists():
-        log(f"reusing the finished FEM run in {run_path} (figures and files are redone)")
-        data = dict(np.load(run_path, allow_pickle=False))
-    else:
-        data = _simulate(cluster, duration, n_snapshots, out, progress, log, stress_interval,
-                         checkpoint_every)
-        with atomic_path(run_path, suffix=".npz") as tmp:
-            np.savez_compressed(tmp, **data)
-        for name in _CHECKPOINT:
-            (out / name).unlink(missing_ok=True)
-    return _write_outputs(cluster, data, out, log)
+    from demfem.jobs import OutputFolder
+
+    with OutputFolder(out, COMMAND, settings, fresh=fresh, outputs=OUTPUT_FILES,
+                      record=_RECORD) as folder:
+        data = _finished_run(folder, log)
+        if data is None:
+            data = _simulate(cluster, duration, n_snapshots, out, progress, log,
+                             stress_interval, checkpoint_every)
+            _check_contacts(cluster, data, duration)
+            run_path = out / "run.npz"
+            with atomic_path(run_path, suffix=".npz") as tmp:
+                np.savez_compressed(tmp, **data)
+            folder.add_files([run_path])
+            for name in _CHECKPOINT:
+                (out / name).unlink(missing_ok=True)
+        return _write_outputs(cluster, data, out, log)
+
+
+def _finished_run(folder: Any, log: Log) -> Optional[dict]:
+    """The histories of the finished FEM run in the folder (``run.npz``, checked against
+    its SHA-256 in the record), or None when there is none. ``run.npz`` from an earlier
+    version, whose record held no SHA-256, is taken as it is and recorded."""
+    run_path = folder.path / "run.npz"
+    if not run_path.exists():
+        return None
+    if folder.relative(run_path) not in folder.files:
+        if folder.previous is None or folder.previous.get("format") == 2:
+            # saved, but killed before its SHA-256 was recorded: the checkpoint is still
+            # there, so the run is redone from it
+            run_path.unlink()
+            return None
+        folder.add_files([run_path])
+        log(f"{run_path} of an earlier demfem version (no SHA-256 then): recorded now")
+    folder.verify(run_path)
+    log(f"reusing the finished FEM run in {run_path} (figures and files are redone)")
+    try:
+        with np.load(run_path, allow_pickle=False) as z:
+            return {k: z[k] for k in z.files}
+    except (OSError, ValueError, zipfile.BadZipFile, EOFError, zlib.error) as exc:
+        raise CheckpointError(f"damaged run file {run_path}: {exc}; start afresh "
+                              f"({folder.fresh_hint})") from None
+
+
+def _check_contacts(cluster: CartridgeCluster, data: dict, duration: float) -> None:
+    """Refuse a run in which 2 or 3, set to hit 1 within it, never touched 1 (no contact
+    force at all): the impact was not resolved, its numbers would be meaningless."""
+    centres = cluster.centres()
+    velocities = cluster.velocities()
+    stats = data["stats"]
+    for k, pair in ((1, "2"), (2, "3")):
+        towards = centres[0] - centres[k]
+        closing = float(np.dot(velocities[k][:2], towards / np.linalg.norm(towards)))
+        if closing <= 0 or cluster.impact_gap / closing >= 0.5 * duration:
+            continue  # not aimed at 1, or arriving late in the run
+        peak = max((float(np.max(data[f"fn_1{pair}_{r}"], initial=0.0)) for _, r in REGIONS))
+        if not peak > 0:
+            raise NumericalError(
+                f"no contact between cartridges 1 and {pair} in the cluster run: {pair} was "
+                f"set to reach 1 at t = {cluster.impact_gap / closing:.3g} s (impact_gap "
+                f"{cluster.impact_gap:g} m at {closing:.3g} m/s) within the {duration:g} s "
+                f"run, but the contact force stayed 0 N ({int(stats[1])} steps of dt = "
+                f"{stats[2]:.3g} s, E = {cluster.material.E:.3g} Pa): the impact was not "
+                "resolved; check the material (a Young's modulus this low makes the step "
+                "too long) and the duration")
 
 
 # ---------------------------------------------------------------------- the FEM run
 #: The checkpoint's two files: the FEM state, and what the run has gathered (written second;
 #: it names the state's step count, so a state without its record is never used).
 _CHECKPOINT = ("checkpoint.state", "checkpoint.npz")
+_STATE_NEW = "checkpoint.state.new"
 
 
 def _save_checkpoint(out: Path, model: Any, k_next: int, wall: float, energy: list,
                      snaps_t: list, sig: list, press: list, frames: list) -> None:
-    model.save_state(out / _CHECKPOINT[0])
+    """Commit a checkpoint like a journal: the FEM state to ``checkpoint.state.new``, then
+    ``checkpoint.npz`` naming its SHA-256 (the commit), then the state renamed into place;
+    a crash at any point leaves a checkpoint :func:`_load_checkpoint` restores."""
+    from demfem.jobs import sha256_file
+
+    state, new_state = out / _CHECKPOINT[0], out / _STATE_NEW
+    model.save_state(new_state)
     en = np.vstack(energy) if energy else np.zeros((0, 10))
     with atomic_path(out / _CHECKPOINT[1], suffix=".npz") as tmp:
         np.savez(tmp, k_next=k_next, steps=int(model.solver.steps), wall=wall, energy=en,
@@ -151,25 +203,55 @@ def _save_checkpoint(out: Path, model: Any, k_next: int, wall: float, energy: li
                  sigma1=np.asarray(sig, np.float32).reshape(len(sig), -1),
                  pressure=np.asarray(press, np.float32).reshape(len(press), -1),
                  frame_time=np.array([f[0] for f in frames], float),
-                 frame_name=np.array([f[1] for f in frames], dtype="U64"))
+                 frame_name=np.array([f[1] for f in frames], dtype="U64"),
+                 state_sha256=np.array(sha256_file(new_state)))
+    os.replace(new_state, state)
 
 
 def _load_checkpoint(out: Path, model: Any, log: Log) -> Optional[dict]:
-    """Restore the model from the checkpoint in ``out``; its gathered lists, or None."""
-    rec = out / _CHECKPOINT[1]
-    if not rec.exists() or not (out / _CHECKPOINT[0]).exists():
+    """Restore the model from the checkpoint in ``out``; its gathered lists, or None when
+    there is none. A damaged one raises CheckpointError naming the file and ``--fresh``."""
+    from demfem.jobs import sha256_file
+
+    rec, state, new_state = out / _CHECKPOINT[1], out / _CHECKPOINT[0], out / _STATE_NEW
+    if not rec.exists():
+        new_state.unlink(missing_ok=True)  # written before a crash, never committed
         return None
-    with np.load(rec, allow_pickle=False) as z:
-        c = {k: z[k] for k in z.files}
-    model.restore_state(out / _CHECKPOINT[0])
-    if int(model.solver.steps) != int(c["steps"]):
-        raise SettingsMismatchError(
-            f"{out}: checkpoint.state is at step {int(model.solver.steps)}, its record at "
-            f"{int(c['steps'])}; remove both (or use --fresh)")
+
+    def damaged(path: Path, why: str) -> CheckpointError:
+        return CheckpointError(f"damaged cluster checkpoint {path}: {why}; start afresh "
+                               "(fresh=True, demfem cluster --fresh)")
+
+    try:
+        with np.load(rec, allow_pickle=False) as z:
+            c = {k: z[k] for k in z.files}
+        digest = str(c["state_sha256"])
+        steps = int(c["steps"])
+    except KeyError as exc:
+        raise damaged(rec, f"no entry {exc} (a checkpoint of an earlier version?)") from None
+    except (OSError, ValueError, zipfile.BadZipFile, EOFError, zlib.error) as exc:
+        raise damaged(rec, str(exc)) from None
+    if new_state.exists():  # finish an interrupted commit, or drop an uncommitted state
+        if sha256_file(new_state) == digest:
+            os.replace(new_state, state)
+        else:
+            new_state.unlink()
+    if not state.exists():
+        raise damaged(state, f"it is missing ({rec.name} names its SHA-256)")
+    if sha256_file(state) != digest:
+        raise damaged(state, f"its SHA-256 differs from the one {rec.name} recorded "
+                             "(damaged or altered)")
+    try:
+        model.restore_state(state)
+    except DemfemError as exc:
+        raise damaged(state, str(exc)) from None
+    if int(model.solver.steps) != steps:
+        raise damaged(rec, f"{state.name} is at step {int(model.solver.steps)}, "
+                           f"{rec.name} at {steps}")
     rows = np.cumsum(np.concatenate([[0], c["energy_rows"]]))
     c["energy_list"] = [c["energy"][a:b] for a, b in zip(rows[:-1], rows[1:])]
     log(f"cluster: resuming from the checkpoint at t = {model.time * 1e3:.4g} ms "
-        f"(step {int(c['steps'])})")
+        f"(step {steps})")
     return c
 
 

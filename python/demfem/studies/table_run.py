@@ -117,7 +117,9 @@ class TableRun:
         from demfem.assess.passages import passages
 
         log = self.passage_log
-        end = float(self.info.get("duration", self.times[-1] if len(self.times) else 0.0))
+        # the run's own last time (whole steps end at or just after the nominal duration)
+        end = max(float(self.info.get("duration", 0.0)),
+                  float(self.times[-1]) if len(self.times) else 0.0)
         if log:
             return passages(self.n_particles, log["removal_log_time"],
                             log["removal_log_index"], log["insertion_log_time"],
