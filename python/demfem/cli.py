@@ -257,14 +257,24 @@ def _cmd_assess(args: argparse.Namespace) -> int:
             f"{MESH_TABLE!r} scene runs with 'demfem run' (throughput, residence time, "
             "steadiness), its breakage assessment is not implemented yet")
 
-    model = None
-    if args.stress_model is not None:
+    model = args.stress_model
+    if model is not None and model not in ("contact", "shell"):
         from demfem.assess import StressModel
 
-        model = StressModel.load(args.stress_model)
+        model = StressModel.load(model)
+    flaw: object = args.flaw_depth
+    if flaw == "none":
+        flaw = None
+    elif flaw != "characteristic":
+        try:
+            flaw = float(flaw)
+        except ValueError:
+            raise InvalidParameterError(f"invalid --flaw-depth {args.flaw_depth!r}: must be "
+                                        "characteristic, none or a depth in m") from None
     result = assess(args.scene, out=args.out, duration=args.duration, quick=args.quick,
                     full=args.full, throughput=args.throughput, fresh=args.fresh,
-                    threads=args.threads, stress_model=model, refeed=not args.no_refeed, csv=args.csv,
+                    threads=args.threads, stress_model=model, refeed=not args.no_refeed,
+                    csv=args.csv, pair_geometry=args.pair_geometry, flaw_depth=flaw,
                     strength=args.strength,
                     progress=True, log=lambda line: print(line, flush=True))
     if "summary" in result:
@@ -431,9 +441,17 @@ def build_parser() -> argparse.ArgumentParser:
                    help="DEM engine threads (results are the same on any number)")
     a.add_argument("--fresh", "--overwrite", dest="fresh", action="store_true",
                    help="replace the assessment in --out (its outputs are removed)")
-    a.add_argument("--stress-model", default=None, metavar="MODEL.json",
-                   help="a stress model file (demfem stress-model); default: the shipped "
-                        "closed-form model")
+    a.add_argument("--stress-model", default=None, metavar="contact|shell|MODEL.json",
+                   help="contact (default: the contact field with friction on top of the "
+                        "shell's bending, demfem.stress), shell (the former shell-only closed "
+                        "form) or a shell-model file (demfem stress-model)")
+    a.add_argument("--pair-geometry", default="crossed", choices=("crossed", "parallel"),
+                   help="how two cartridges touch: crossed at 90 degrees (default, a point "
+                        "contact) or parallel along the body (a line contact)")
+    a.add_argument("--flaw-depth", default="characteristic", metavar="characteristic|none|M",
+                   help="depth of the outer surface's flaws at which the contact tension is "
+                        "felt: characteristic (default: the flaw that fails at sigma_0), none "
+                        "(the surface value), or a depth in m")
     a.set_defaults(func=_cmd_assess)
     sm = sub.add_parser("stress-model", help="refit the stress model of demfem assess from a "
                         "designed grid of FEM two-cartridge collisions, with held-back error")
@@ -534,7 +552,12 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         print("demfem: interrupted", file=sys.stderr)
         return 130
     except CheckpointError as exc:
-        print(f"demfem: error: {exc}{fresh_hint}", file=sys.stderr)
+        hint = "" if "--fresh" in str(exc) else fresh_hint
+        print(f"demfem: error: {exc}{hint}", file=sys.stderr)
+        return 1
+    except MemoryError:
+        print("demfem: error: out of memory (a smaller scene, a shorter run or fewer "
+              "snapshots needs less)", file=sys.stderr)
         return 1
     except SettingsMismatchError as exc:
         print(f"demfem: error: {exc}", file=sys.stderr)

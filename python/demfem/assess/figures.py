@@ -15,8 +15,8 @@ FIGURES = {
     "risk_map.png": "Where on the table the risk comes from: each bin's share of the "
                     "window's breakage hazard Σ −ln(1 − P_k) (both partners counted), by "
                     "contact point, on the table's outline (walls black, gate red, the "
-                    "opening dotted); the labels give each wall's share of the hazard of its "
-                    "impacts; belt along +x.",
+                    "opening dotted); beside it each wall's share of the hazard of its impacts; "
+                    "belt along +x.",
     "impact_speeds.png": "Normal impact speed at contact onset: every impact onset (not the "
                          "belt) and the events kept by the minimum-speed filter (dashed line).",
     "collision_rate.png": "Events per second against time; the statistics window is shaded, "
@@ -76,13 +76,14 @@ def make_figures(out: Path, data: dict[str, Any]) -> dict[str, bytes]:
         gate = wall["name"] == "gate"
         ax.plot(seg[:, 0], seg[:, 1], color="C3" if gate else "k", lw=3 if gate else 2,
                 solid_capstyle="butt")
-        share = data.get("wall_shares", {}).get(wall["name"])
-        if share is not None:
-            mid = seg.mean(axis=0)
-            ax.annotate(f"{wall['name'].replace('_', ' ')}: {100 * share:.0f} %", mid,
-                        xytext=(0, -12 if wall["name"] == "lower_side" else 6),
-                        textcoords="offset points", ha="center", fontsize=8,
-                        color="C3" if gate else "k")
+
+    shares = data.get("wall_shares") or {}
+    if shares:
+        text = "share of the hazard by wall:\n" + "\n".join(
+            f"  {name.replace('_', ' ')}: {100 * v:.2g} %"
+            for name, v in sorted(shares.items(), key=lambda kv: -kv[1]))
+        ax.text(1.35, 0.0, text, transform=ax.transAxes, fontsize=8, va="bottom",
+                ha="left")
     if data.get("opening") is not None:
         x_end, w_min, w_max = data["opening"]
         ax.plot([x_end, x_end], [0.0, w_max], color="C3", ls=":", lw=1.5)
@@ -91,8 +92,7 @@ def make_figures(out: Path, data: dict[str, Any]) -> dict[str, bytes]:
     ax.set_xlabel("x (belt direction →), m")
     ax.set_ylabel("y, m")
     ax.set_aspect("equal")
-    ax.set_title(f"where the hazard comes from, window {t0:.3g}–{t1:.3g} s "
-                 "(labels: share by wall)", fontsize=10)
+    ax.set_title(f"where the hazard comes from, window {t0:.3g}–{t1:.3g} s", fontsize=10)
     figs["risk_map.png"] = _png(fig)
     plt.close(fig)
 

@@ -81,13 +81,31 @@ def render_report(risk: dict[str, Any], figures: dict[str, bytes],
         ("share of the hazard from the inner surface", fmt(s["inner_share"])),
         ("impacts on walls and gate in the window", fmt(s["n_wall_events_window"])),
         ("share of the hazard from wall and gate impacts", fmt(s["wall_share"])),
-        *((f"share of the hazard from the {name}", fmt(v))
+        *((f"share of the hazard from the {name.replace('_', ' ')}", fmt(v))
           for name, v in sorted(s.get("wall_share_by_wall", {}).items(), key=lambda kv: -kv[1])),
         ("largest peak contact force in the window, N", fmt(s["max_force_N"])),
         ("largest inner σ1 in the window, MPa", fmt((s["max_sigma_inner_Pa"] or 0) / 1e6)),
         ("largest outer σ1 in the window, MPa", fmt((s["max_sigma_outer_Pa"] or 0) / 1e6)),
     ]
     parts.append(_table(rows, cls="summary"))
+    splits = (risk.get("interval") or {}).get("splits") or {}
+    if splits:
+        names = {"component": "by surface and mechanism", "with": "by place on the table"}
+        what = {"outer": "outer surface: contact tension (with bending)",
+                "inner": "inner surface: bending tension"}
+        parts.append("<h3>Where the hazard comes from, with 95 % intervals</h3><p>Shares of "
+                     "the hourly number from the same gate periods as its interval.</p>")
+        for group in ("component", "with"):
+            rows_s = []
+            for label, d in sorted((splits.get(group) or {}).items(),
+                                   key=lambda kv: -(kv[1].get("share") or 0)):
+                lo, hi = d.get("share_lower"), d.get("share_upper")
+                rng = (f" ({fmt(100 * lo)} – {fmt(100 * hi)} %)" if lo is not None
+                       and hi is not None else "")
+                rows_s.append((what.get(label, label.replace("_", " ")),
+                               f"{fmt(100 * (d.get('share') or 0))} %{rng}"))
+            if rows_s:
+                parts.append(_table(rows_s, (names[group], "share of the hazard")))
     parts.append("<h2>Worst collisions</h2><p>An impact began at least at the minimum "
                  "speed; a contact pressed by the queue began slower but the DEM pressed it to "
                  "at least the force of an impact at that speed.</p>"

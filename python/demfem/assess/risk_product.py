@@ -171,11 +171,52 @@ def _interval(events: np.ndarray, p: dict[str, np.ndarray], inside: np.ndarray,
             "table": carried(pr["broken_per_hour_table"]), "document": doc}
 
 
+def _tail(events: np.ndarray, stress: dict[str, np.ndarray], p: dict[str, np.ndarray],
+          inside: np.ndarray, window: tuple[float, float], period: Optional[float],
+          hazard_of_force: Any, force_cap: float) -> dict[str, Any]:
+    """Peaks over threshold of the window's cartridge–cartridge peak forces
+    (:mod:`demfem.risk.tail`): the GPD fit with its threshold diagnostic, the expected rate of
+    impacts harder than any seen, and the hazard per hour with the events above the threshold
+    replaced by the model's expectation (forces capped at ``force_cap``, N), beside the
+    counted one. A window too short for a fit says why."""
+    from demfem.errors import InvalidParameterError
+    from demfem.risk.tail import expected_beyond, fit_tail, tail_corrected_rate
+
+    sel = inside & (events["partner"] == 0)
+    f = np.asarray(stress["force_N"], float)[sel]
+    h = 2.0 * -np.log1p(-np.asarray(p["p_event"], float)[sel])
+    w = float(window[1] - window[0])
+    try:
+        model = fit_tail(f, w)
+        beyond = expected_beyond(model, hazard_of_force, upper=force_cap)
+        corrected = tail_corrected_rate(f, h, w, hazard_of_force, model=model,
+                                        upper=force_cap, times=events["time"][sel],
+                                        window=window, period=period or 1.0)
+    except InvalidParameterError as exc:
+        return {"status": f"no tail model: {exc}"}
+    per_h = 3600.0
+    return {"status": "ok", "threshold_N": model.threshold, "shape": model.shape,
+            "shape_se": model.shape_se, "scale_N": model.scale,
+            "n_exceedances": model.n_exceedances, "largest_force_N": model.max_value,
+            "force_cap_N": force_cap,
+            "impacts_beyond_largest_per_hour": per_h * beyond.rate_beyond,
+            "hazard_beyond_largest_per_hour": [per_h * beyond.estimate, per_h * beyond.lower,
+                                               per_h * beyond.upper],
+            "pairs_hazard_per_hour_counted": per_h * corrected.empirical,
+            "pairs_hazard_per_hour_tail_model": [per_h * corrected.estimate,
+                                                 per_h * corrected.lower,
+                                                 per_h * corrected.upper],
+            "note": "cartridge-cartridge events; the hazard of an impact of force F from the "
+                    "stress model with the tail events' median friction ratio and the law's "
+                    "duration at F; both partners counted"}
+
+
 def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[str, Any],
                   stress: dict[str, np.ndarray], model, scg, window: tuple[float, float],
                   throughput: Optional[float], settings: dict[str, Any],
                   e_stress: float, csv: bool = False,
-                  surfaces: Optional[dict[str, Any]] = None) -> list[Path]:
+                  surfaces: Optional[dict[str, Any]] = None,
+                  hazard_of_force: Any = None, force_cap: float = math.inf) -> list[Path]:
     """Compute the risk stage and write its files into ``out`` (``events.parquet``,
     ``passages.parquet`` and, with ``csv``, the same as CSV); returns their paths."""
     from demfem.assess.npz import flatten, save_npz
@@ -275,7 +316,9 @@ def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[st
     if w < 0.5:
         warnings.append(f"Short statistics window ({w:.3g} s, less than a quarter of the "
                         "gate period of the default table): a smoke run, not an assessment.")
-    doc = {"format": 2, "summary": summary, "interval": ci["document"],
+    tail = (_tail(events, stress, p, inside, window, period, hazard_of_force, force_cap)
+            if hazard_of_force is not None else {"status": "not asked for"})
+    doc = {"format": 2, "summary": summary, "interval": ci["document"], "tail": tail,
            "steady_state": steady, "worst_events": worst,
            "events": ev_summary, "warnings": warnings,
            "basis": _basis(model, scg, ev_summary, e_stress, table, stress, surfaces, settings),

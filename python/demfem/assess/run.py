@@ -125,6 +125,48 @@ def _stress_curves(stress: dict[str, np.ndarray], table, e_stress: float, model:
                                     flaw_depth)}
 
 
+def _hazard_of_force(events: np.ndarray, stress: dict[str, np.ndarray], table, e_stress: float,
+                     model: Any, pair_geometry: str, surfaces: dict[str, Any],
+                     flaw_depth: Optional[float], scg: Any, window: tuple[float, float]
+                     ) -> tuple[Any, float]:
+    """h(F): the hazard (both partners) of a cartridge–cartridge impact of peak force F (N) at
+    the window's hard impacts' median friction ratio Q/F and the calibrated law's duration at
+    F, for the tail model; and the force cap, the law's force of a 1 m/s impact (N)."""
+    from demfem.assess.impact import ImpactLaw, cartridge_body
+    from demfem.assess.risk_stage import event_probabilities
+    from demfem.stress.stage import collision_stresses
+
+    body = cartridge_body(e_stress, table.poisson_ratio, table.cartridge)
+    law = ImpactLaw(body, body)
+    speeds = np.geomspace(1e-4, 1.0, 200)
+    f_grid, tau_grid = law.force(speeds), law.duration(speeds)
+    sel = ((events["time"] >= window[0]) & (events["time"] <= window[1])
+           & (events["partner"] == 0))
+    f_ev = np.asarray(stress["force_N"], float)[sel]
+    ratio = 0.0
+    if f_ev.size:
+        hard = f_ev >= np.quantile(f_ev, 0.9)
+        ratio = float(np.median(np.asarray(stress["tangential_force_N"], float)[sel][hard]
+                                / f_ev[hard]))
+
+    def hazard(force: np.ndarray) -> np.ndarray:
+        f = np.maximum(np.asarray(force, float), 1e-9)
+        tau = np.interp(f, f_grid, tau_grid)
+        st = collision_stresses(np.zeros(f.shape), np.zeros(f.shape, np.int64), e_stress,
+                                table.poisson_ratio, measured_force=f,
+                                measured_impulse=f * tau / (0.5 * np.pi),
+                                measured_tangential=ratio * f, model=model,
+                                cartridge=table.cartridge, pair_geometry=pair_geometry,
+                                friction=table.friction,
+                                weibull_modulus_inner=surfaces["inner"].weibull_modulus,
+                                weibull_modulus_outer=surfaces["outer"].weibull_modulus,
+                                flaw_depth=flaw_depth)
+        p = event_probabilities(st, surfaces["inner"], surfaces["outer"], scg)
+        return 2.0 * -np.log1p(-p["p_event"])
+
+    return hazard, float(f_grid[-1])
+
+
 def _event_min_force(table, e_stress: float, v_min: float) -> float:
     """Peak force (N) of a cartridge–cartridge impact at ``v_min`` (m/s): a contact that began
     slower is an event if the DEM measured at least this force on it (pressed by the
@@ -432,9 +474,11 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
         done = book.is_done("risk")
         header(5, "Weibull probabilities per event, cartridge and hour", done)
         if not done:
+            hof, cap = _hazard_of_force(events, stress, table, e_stress, model, pair_geometry,
+                                        surfaces, c_flaw, scg, (t0, end))
             files = risk_document(out, run, table, events, ev_summary, stress, model, scg,
                                   (t0, end), q, settings, e_stress, csv=csv,
-                                  surfaces=surfaces)
+                                  surfaces=surfaces, hazard_of_force=hof, force_cap=cap)
             book.complete("risk", files)
         risk = json.loads((out / "risk.json").read_text(encoding="utf-8"))
         s = risk["summary"]

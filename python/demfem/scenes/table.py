@@ -102,6 +102,10 @@ PARTICLES = ("sphere", "clump", "cylinder")
 #: :func:`demfem.dem.from_scene`).
 TABLE_CONTACT_MODELS = ("hertz_reissner_mindlin", "hertz_mindlin", "fem_line")
 
+#: Most start sites the constricted section of a table may hold (a bound on the site loop
+#: and on memory: 10^6 spheres is far beyond what one machine runs).
+MAX_START_SITES = 1e6
+
 #: Name of this scene in scene files (the optional key ``scene``).
 SCENE_NAME = "accumulation_table"
 
@@ -290,6 +294,14 @@ class AccumulationTable:
         check_range("friction", self.friction, 0.0, inf, lo_open=False)
         check_range("restitution", self.restitution, 0.0, 1.0, hi_open=False)
         check_range("rolling_resistance", self.rolling_resistance, 0.0, inf, lo_open=False)
+        # the constricted section's sites are found by a loop: bound it before it runs
+        sites = (self.x_end - self.length) * self.width / (pitch * pitch * math.sqrt(3) / 2)
+        if not sites <= MAX_START_SITES:
+            raise InvalidParameterError(
+                f"invalid width = {self.width!r} with tilted_wall_length = "
+                f"{self.tilted_wall_length!r}: the constricted section would hold about "
+                f"{sites:.3g} spheres of {2 * r:g} m; demfem tables hold at most "
+                f"{MAX_START_SITES:g} (a table that size is not a scene one machine can run)")
         if self.contact_model not in TABLE_CONTACT_MODELS:
             raise InvalidParameterError(
                 f"invalid contact_model = {self.contact_model!r}: must be one of "
@@ -492,7 +504,9 @@ class AccumulationTable:
         tags = np.zeros(len(xy), np.int32)
         n_hex = len(hexagonal)
         sq_index = np.arange(n_hex, len(xy))
-        first_line = sq_index[np.isclose(square[:, 0], self.length - half)]
+        # the first line is the most downstream square column (index < rows), whatever the
+        # table's length (an isclose on x loses it at km scales)
+        first_line = sq_index[np.arange(len(square)) < min(rows, len(square))]
         tags[first_line] = Tag.FIRST_LINE
         rest = sq_index[tags[sq_index] == Tag.NONE]
         centre = square.mean(axis=0)
