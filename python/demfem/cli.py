@@ -125,6 +125,17 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     def progress(done: int, total: int) -> None:
         print(f"\r  runs finished: {done}/{total}", end="", flush=True)
 
+    if args.replicas is not None:
+        from demfem.assess.ranking import ranked_sweep
+
+        ranking = ranked_sweep(grid, args.runner, args.out, args.replicas,
+                               rank_by=args.rank_by or "broken_per_hour", seed=args.seed,
+                               scheduler=args.scheduler, n_workers=args.workers,
+                               progress=progress)
+        print()
+        print(ranking.text())
+        print(f"written: {args.out}/results.csv, {args.out}/ranking.json")
+        return 0
     res = sweep(grid, args.runner, args.out, scheduler=args.scheduler, n_workers=args.workers,
                 progress=progress)
     print(f"\nran {res.ran}, skipped {res.skipped} already finished; table: {res.table_path}")
@@ -271,12 +282,25 @@ def _cmd_assess(args: argparse.Namespace) -> int:
         except ValueError:
             raise InvalidParameterError(f"invalid --flaw-depth {args.flaw_depth!r}: must be "
                                         "characteristic, none or a depth in m") from None
-    result = assess(args.scene, out=args.out, duration=args.duration, quick=args.quick,
-                    full=args.full, throughput=args.throughput, fresh=args.fresh,
-                    threads=args.threads, stress_model=model, refeed=not args.no_refeed,
+    settings = dict(duration=args.duration, quick=args.quick, full=args.full,
+                    throughput=args.throughput, stress_model=model, refeed=not args.no_refeed,
                     csv=args.csv, pair_geometry=args.pair_geometry, flaw_depth=flaw,
-                    strength=args.strength,
-                    progress=True, log=lambda line: print(line, flush=True))
+                    strength=args.strength)
+    if args.replicas is not None or args.precision is not None:
+        from demfem.assess.replicas import assess_replicas
+
+        assess_replicas(args.scene, out=args.out,
+                        replicas=2 if args.replicas is None else args.replicas,
+                        precision=args.precision, scheduler=args.scheduler,
+                        n_workers=args.workers, seed=0 if args.seed is None else args.seed,
+                        fresh=args.fresh, reports=not args.no_reports,
+                        **({} if args.max_replicas is None
+                           else {"max_replicas": args.max_replicas}),
+                        log=lambda line: print(line, flush=True), **settings)
+        return 0
+    result = assess(args.scene, out=args.out, fresh=args.fresh, threads=args.threads,
+                    seed=args.seed, progress=True, log=lambda line: print(line, flush=True),
+                    **settings)
     if "summary" in result:
         from demfem.assess.headline import headline
 
@@ -322,8 +346,11 @@ def _cmd_cluster(args: argparse.Namespace) -> int:
                     n_snapshots=args.snapshots, fresh=args.fresh,
                     log=lambda line: print(line, flush=True))
     fp = s["force_peaks"]
-    print("peak normal / tangential force on 1 (N): " + "; ".join(
-        f"{k} {v['normal_N']:.3g} / {v['tangential_N']:.3g}" for k, v in fp.items()))
+    print("peak normal / tangential force on 1, smoothed over "
+          f"{s['smoothing_s'] * 1e6:g} us (N): " + "; ".join(
+              f"{k} {v['normal_N']:.3g} / {v['tangential_N']:.3g}" for k, v in fp.items()))
+    print("raw peak normal force on 1 (N, the penalty contact's step-to-step peak): "
+          + "; ".join(f"{k} {v.get('raw_normal_N', float('nan')):.3g}" for k, v in fp.items()))
     print(f"peak sigma1 on 1: {s['sigma1_body_max_Pa'] / 1e6:.4g} MPa; outputs in {args.out}")
     return 0
 
@@ -385,6 +412,13 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--rank-by", default=None, metavar="KEY",
                    help="print the points ranked by this result (lowest first), e.g. "
                         "broken_per_hour with --runner demfem.assess.sweep_runner:risk_point")
+    s.add_argument("--replicas", type=int, default=None, metavar="R",
+                   help="R paired replicas per set-up (seeds --seed ... --seed+R-1: common "
+                        "random starts), ranked by --rank-by (default broken_per_hour) with "
+                        "each set-up's 95%% interval and whether its difference to the best "
+                        "is real (paired tests, Holm-corrected); --out/ranking.json")
+    s.add_argument("--seed", type=int, default=0,
+                   help="with --replicas: the first replica's seed (0)")
     s.set_defaults(func=_cmd_sweep)
     f5 = _add_study(sub, "fig5", "Fig. 5: first-line force for A, T, V_belt and the gentlest "
                     "set-up")
@@ -452,6 +486,29 @@ def build_parser() -> argparse.ArgumentParser:
                    help="depth of the outer surface's flaws at which the contact tension is "
                         "felt: characteristic (default: the flaw that fails at sigma_0), none "
                         "(the surface value), or a depth in m")
+    a.add_argument("--replicas", type=int, default=None, metavar="N",
+                   help="run N independent replicas of the table (perturbed starts, seeds "
+                        "--seed ... --seed+N-1) on Dask and merge them: the hourly number "
+                        "with a 95%% interval from their scatter (--out/replica_<k>, "
+                        "--out/replicas.json; docs/replicas.md)")
+    a.add_argument("--precision", type=float, default=None, metavar="FRACTION",
+                   help="with replicas: add replicas, a batch of the worker count at a "
+                        "time, until the interval's half-width is at most this fraction of "
+                        "the number (e.g. 0.2), or --max-replicas is reached")
+    a.add_argument("--max-replicas", type=int, default=None, metavar="N",
+                   help="most replicas --precision runs (64)")
+    a.add_argument("--seed", type=int, default=None,
+                   help="perturbed start: with replicas the first replica's seed (0); "
+                        "alone, one run from the perturbed start of this seed (default: the "
+                        "scene's own start)")
+    a.add_argument("--scheduler", default=None,
+                   help="with replicas: a Dask scheduler address (tcp://host:8786) or "
+                        "'serial'; default: a LocalCluster on this machine")
+    a.add_argument("--workers", type=int, default=None,
+                   help="with replicas: LocalCluster worker processes (default: the cores)")
+    a.add_argument("--no-reports", action="store_true",
+                   help="with replicas: stop each replica after its risk stage (no "
+                        "report.html per replica; the merge needs only risk.json)")
     a.set_defaults(func=_cmd_assess)
     sm = sub.add_parser("stress-model", help="refit the stress model of demfem assess from a "
                         "designed grid of FEM two-cartridge collisions, with held-back error")

@@ -199,6 +199,14 @@ def test_tiny_run_writes_every_output(tmp_path):
     for pair in ("1-2", "1-3"):
         depth = summary["through_wall"][pair]["depth_fraction"]
         assert 0.0 < min(depth) and max(depth) < 1.0, (pair, depth)
+        # taken at the pair's own force peak (the snapshot nearest it), never before it touched
+        tw = summary["through_wall"][pair]
+        peak_t = summary["force_peaks"][f"{pair}_{tw['region']}"]["time_s"]
+        step = 3e-4 / 3
+        assert abs(tw["time_s"] - peak_t) <= 0.5 * step + 1e-12, (pair, tw["time_s"], peak_t)
+        raw = summary["force_peaks"][f"{pair}_{tw['region']}"]["raw_normal_N"]
+        assert raw >= summary["force_peaks"][f"{pair}_{tw['region']}"]["normal_N"]
+    assert summary["layers"] == c.layers
     # a rerun reuses the FEM run; other settings are refused
     (out / "cluster_sigma1.png").unlink()
     s2 = run_cluster(c, duration=3e-4, out=out, progress=False, n_snapshots=4)
@@ -259,7 +267,7 @@ def test_shell_cluster_geometry_and_tiny_run(tmp_path):
                  "cluster_sigma1_through_wall.png", "cluster_sigma1_map_1-2_bottom.png",
                  "summary.json", "run.npz"):
         assert (out / name).exists(), name
-    assert s["elements"] == "shell" and s["steps"] > 0
+    assert s["elements"] == "shell" and s["steps"] > 0 and "layers" not in s
     assert s["force_peaks"]["1-2_bottom"]["normal_N"] > 0
     assert s["through_wall"]["1-2"]["depth_fraction"][0] == pytest.approx(0.0)
     assert s["through_wall"]["1-2"]["depth_fraction"][-1] == pytest.approx(1.0)

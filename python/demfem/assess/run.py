@@ -27,7 +27,7 @@ from demfem.assess.events import DEFAULT_MIN_SPEED
 from demfem.assess.npz import load_npz, save_npz
 from demfem.assess.stages import STAGES, StageBook
 from demfem.stress.stress_model import StressModel
-from demfem.errors import InvalidParameterError, check_positive, check_range
+from demfem.errors import InvalidParameterError, check_count, check_positive, check_range
 
 __all__ = ["assess", "OUTPUT_FILES", "QUICK_DURATION", "DEFAULT_DURATION", "FULL_DURATION",
            "steady_rule", "duration_help", "STEADY_DEFAULT", "STEADY_FULL"]
@@ -190,7 +190,8 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
            threads: int = 1, checkpoint_every: float = 15.0,
            log: Callable[[str], None] = print, progress: bool = False,
            stop_after: Optional[str] = None, refeed: bool = True,
-           csv: bool = False, strength: Optional[str | Path] = None) -> dict[str, Any]:
+           csv: bool = False, strength: Optional[str | Path] = None,
+           seed: Optional[int] = None) -> dict[str, Any]:
     """Run (or resume) the assessment; returns the risk document (``risk.json``'s content).
 
     Args:
@@ -234,6 +235,11 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
         strength: a strength file (``demfem strength-fit``,
             :func:`demfem.risk.strength_file.load_strength_file`) with the Weibull parameters
             of the user's own glass; None: the planning assumptions of :mod:`demfem.risk`.
+        seed: start the table from the perturbed start of this seed (whole number >= 0;
+            :func:`demfem.scenes.perturb.perturbed_start`: every cartridge moved in the
+            belt's plane by at most half its clearance, 40 µm on the default table), so that
+            runs of one scene are independent replicas; None: the scene's own start.
+            Recorded in the settings (``start_seed``).
     """
     from demfem.pipeline import load_scene
     from demfem.risk import INNER_SURFACE, OUTER_SURFACE, SCG_BOROSILICATE
@@ -264,6 +270,8 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
     if not isinstance(refeed, bool):
         raise InvalidParameterError(f"invalid refeed = {refeed!r}: must be True or False")
     check_positive("checkpoint_every", checkpoint_every)
+    if seed is not None:
+        seed = check_count("seed", seed, 0)
     if stop_after is not None and stop_after not in STAGES:
         raise InvalidParameterError(f"invalid stop_after = {stop_after!r}: must be one of "
                                     f"{STAGES}")
@@ -322,6 +330,8 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
                 "strength_source": surfaces["source"], "flaw_depth_m": c_flaw,
                 "dem_model": table.contact_model, "dem_events": "measured",
                 "tables": "parquet+csv" if csv else "parquet"}
+    if seed is not None:
+        settings["start_seed"] = seed
     out = Path(out)
     # the folder's lock is held from here to the end, released on return or error
     book = StageBook(out, settings, fresh, OUTPUT_FILES)
@@ -387,7 +397,8 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
                                 progress=bar, checkpoint=out / "table.ck",
                                 checkpoint_every=checkpoint_every, fresh=fresh,
                                 record_events=True, steady=rule,
-                                keep_events=(v_min, _event_min_force(table, e_stress, v_min)))
+                                keep_events=(v_min, _event_min_force(table, e_stress, v_min)),
+                                seed=seed)
             finally:
                 if bar is not None:
                     bar.close()

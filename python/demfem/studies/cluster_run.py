@@ -516,9 +516,12 @@ def _write_outputs(cluster: CartridgeCluster, data: dict, out: Path, log: Log) -
     through: dict[str, dict] = {}
     fig, ax = plt.subplots(figsize=(6, 4.5))
     for p in PAIRS:
-        best = max(((zone_max[(p, r)].max(), r) for r, _ in REGIONS))
-        r = best[1]
-        k = int(np.argmax(zone_max[(p, r)]))
+        # at the pair's own force peak (the region where its contact force peaked), never
+        # before it first touched
+        r = max(((peaks.get(f"1-{p}_{rn}", {}).get("normal_N", 0.0), i)
+                 for i, (_, rn) in enumerate(REGIONS)))[1]
+        tk = peaks.get(f"1-{p}_{REGIONS[r][1]}", {}).get("time_s", 0.0)
+        k = int(np.argmin(np.abs(np.asarray(ts) - tk))) if len(ts) else 0
         zmask = _zone(geo, p, r)
         idx = np.flatnonzero(zmask)
         e_star = idx[int(np.argmax(sig[k, idx]))]
@@ -530,7 +533,8 @@ def _write_outputs(cluster: CartridgeCluster, data: dict, out: Path, log: Log) -
         ri, ro = c.radii_at(np.clip(geo["z"][sel][order], 0.0, c.length))
         depth = (geo["r"][sel][order] - ri) / (ro - ri)
         vals = sig[k, sel][order]
-        ax.plot(depth, vals / 1e6, "o-", label=f"1-{p} {REGIONS[r][1]}, t = {ts[k] * 1e3:.3g} ms")
+        ax.plot(depth, vals / 1e6, "o-", label=f"1-{p} {REGIONS[r][1]}, at its force peak, "
+                f"t = {ts[k] * 1e3:.3g} ms")
         through[f"1-{p}"] = {"region": REGIONS[r][1], "time_s": float(ts[k]),
                              "z_m": float(geo["z"][e_star]),
                              "depth_fraction": depth.tolist(), "sigma1_Pa": vals.tolist(),
@@ -539,7 +543,7 @@ def _write_outputs(cluster: CartridgeCluster, data: dict, out: Path, log: Log) -
     ax.axhline(0, color="k", lw=0.5)
     ax.set_xlabel("position through the wall: 0 inner surface, 1 outer surface")
     ax.set_ylabel(r"$\sigma_1$ (MPa)")
-    ax.set_title(r"$\sigma_1$ through the wall at the contact, at the peak")
+    ax.set_title(r"$\sigma_1$ through the wall at each pair's contact, at its force peak")
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
     fig.tight_layout()
@@ -579,7 +583,8 @@ def _write_outputs(cluster: CartridgeCluster, data: dict, out: Path, log: Log) -
     k_peak = int(np.argmax(body_max)) if len(body_max) else 0
     summary = {
         "case": cluster.case, "springs": cluster.springs, "elements": cluster.elements,
-        "layers": int(cluster.layers), "v2_m_s": cluster.v2, "v3_m_s": cluster.v3,
+        **({"layers": int(cluster.layers)} if cluster.elements == "tet" else {}),
+        "v2_m_s": cluster.v2, "v3_m_s": cluster.v3,
         "direction_2_deg": cluster.direction_2_deg, "direction_3_deg": cluster.direction_3_deg,
         "E_Pa": cluster.material.E, "duration_s": float(ts[-1]) if len(ts) else 0.0,
         "wall_time_s": float(stats[0]), "steps": int(stats[1]),

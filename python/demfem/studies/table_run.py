@@ -288,7 +288,8 @@ def run_table(table: AccumulationTable, duration: float, sample_interval: float 
               dt: Optional[float] = None, fresh: bool = False,
               overlap_fraction: float = 0.1, record_events: bool = False,
               steady: Optional[SteadyRule] = None,
-              keep_events: Optional[tuple[float, float]] = None) -> TableRun:
+              keep_events: Optional[tuple[float, float]] = None,
+              seed: Optional[int] = None) -> TableRun:
     """Run ``table`` for ``duration`` s of simulated time and sample it every
     ``sample_interval`` s (samples at 0, Δ, 2Δ, ... up to ``duration``).
 
@@ -325,6 +326,10 @@ def run_table(table: AccumulationTable, duration: float, sample_interval: float 
         keep_events: (min_speed m/s, min_force N): keep only the contact events that began
             at least that fast or reached at least that force (the pack's resting chatter,
             half of all contacts, is then not stored); None keeps every one.
+        seed: start from the perturbed start of this seed
+            (:func:`demfem.scenes.perturb.perturbed_start`); None: the table's own start.
+            In the run's settings (``start_seed``: a checkpoint of another seed is
+            refused).
 
     Returns:
         The :class:`TableRun`.
@@ -341,6 +346,10 @@ def run_table(table: AccumulationTable, duration: float, sample_interval: float 
         raise InvalidParameterError(f"invalid checkpoint_every = {checkpoint_every!r}: must "
                                     "be a finite number of seconds > 0")
     scene = table.build()
+    if seed is not None:
+        from demfem.scenes.perturb import perturbed_start
+
+        scene = perturbed_start(scene, seed)
     belt = _belt_plane(scene)
     sim = from_scene(scene, model=model, threads=threads, record_onsets=True, dt=dt,
                      record_events=record_events)
@@ -351,6 +360,8 @@ def run_table(table: AccumulationTable, duration: float, sample_interval: float 
     settings = run_settings(table, duration, sample_interval, model, dt, record_events)
     if steady is not None:
         settings["steady"] = steady.to_dict()
+    if seed is not None:
+        settings["start_seed"] = int(seed)
     if record_events and keep_events is not None:
         keep_events = (float(keep_events[0]), float(keep_events[1]))
         settings["keep_events"] = list(keep_events)
