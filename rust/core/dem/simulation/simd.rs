@@ -7,9 +7,10 @@
 
 use super::batch::Batch;
 use super::gather::{particle_chunk, ParticleCtx};
-use super::pair::{pair_chunk, PairCtx, PairLists};
+use super::chunk::{pair_chunk, wall_chunk};
+use super::pair::{PairCtx, PairLists};
 use super::state::{Flips, PairContact, WallContact, WallDetail, WallOut};
-use super::wall::{wall_chunk, BlockWalls, WallCtx};
+use super::wall::{BlockWalls, WallCtx};
 use crate::geometry::Vec3;
 
 /// Whether the step may use its AVX2 build ([`crate::cpu::has_avx2`]).
