@@ -24,8 +24,8 @@ use demfem::fem::mesh::{box_tet_mesh, place, union, TriMesh};
 use demfem::fem::shell::{ShellExplicit, ShellModel};
 use demfem::fem::stress::{element_stresses, max_principal_stress};
 use demfem::fem::{
-    AxisymmetricProfile, ExplicitConfig, ExplicitSolver, LinearElastic, LoadHistory,
-    Prescribed, PrescribedKind,
+    AxisymmetricProfile, ExplicitConfig, ExplicitSolver, LinearElastic, LoadHistory, Prescribed,
+    PrescribedKind,
 };
 use std::f64::consts::PI;
 
@@ -95,11 +95,7 @@ fn tet_cluster() -> (ExplicitSolver, ContactModel, Vec<[f64; 3]>) {
     cfg.energy_interval = 50;
     let s = ExplicitSolver::new(&mesh, cfg).unwrap();
     let n = mesh.nodes.len();
-    let region: Vec<u32> = mesh
-        .nodes
-        .iter()
-        .map(|p| u32::from(p[2] > 6e-3))
-        .collect();
+    let region: Vec<u32> = mesh.nodes.iter().map(|p| u32::from(p[2] > 6e-3)).collect();
     let settings = ContactSettings {
         friction: 0.2,
         output_interval: 5,
@@ -153,10 +149,20 @@ fn tet_report(name: &str, s: &ExplicitSolver, mesh: &demfem::fem::TetMesh) {
     let e = s.energy();
     let ce = s.contact_energy();
     let sig = element_stresses(mesh, &glass(), s.displacement()).unwrap();
-    let s1 = sig.iter().map(max_principal_stress).fold(f64::MIN, f64::max);
+    let s1 = sig
+        .iter()
+        .map(max_principal_stress)
+        .fold(f64::MIN, f64::max);
     let p = peaks(c.history(), c.channels().len());
     let hist_hash = hash(s.energy_history().iter().flat_map(|e| {
-        [e.time, e.kinetic, e.internal, e.external_work, e.damping_work, e.initial]
+        [
+            e.time,
+            e.kinetic,
+            e.internal,
+            e.external_work,
+            e.damping_work,
+            e.initial,
+        ]
     }));
     line(
         name,
@@ -164,10 +170,25 @@ fn tet_report(name: &str, s: &ExplicitSolver, mesh: &demfem::fem::TetMesh) {
             ("steps", s.steps() as f64),
             ("dt", s.dt()),
             ("time", s.time()),
-            ("u_v_hash", f64::from_bits(hash(s.displacement().iter().chain(s.velocity()).flatten().cloned()))),
-            ("f_contact_hash", f64::from_bits(hash(s.contact_force().iter().flatten().cloned()))),
+            (
+                "u_v_hash",
+                f64::from_bits(hash(
+                    s.displacement()
+                        .iter()
+                        .chain(s.velocity())
+                        .flatten()
+                        .cloned(),
+                )),
+            ),
+            (
+                "f_contact_hash",
+                f64::from_bits(hash(s.contact_force().iter().flatten().cloned())),
+            ),
             ("energy_hist_hash", f64::from_bits(hist_hash)),
-            ("contact_hist_hash", f64::from_bits(hash(c.history().iter().cloned()))),
+            (
+                "contact_hist_hash",
+                f64::from_bits(hash(c.history().iter().cloned())),
+            ),
             ("kinetic", e.kinetic),
             ("internal", e.internal),
             ("external_work", e.external_work),
@@ -230,7 +251,9 @@ fn tet_bc_fingerprint() {
     });
     s.set_prescribed(&p, LoadHistory::Ramp { rise_time: 2e-4 })
         .unwrap();
-    let loads: Vec<[f64; 3]> = (0..n).map(|i| [1e-3 * (i % 3) as f64, 2e-3, -1e-3]).collect();
+    let loads: Vec<[f64; 3]> = (0..n)
+        .map(|i| [1e-3 * (i % 3) as f64, 2e-3, -1e-3])
+        .collect();
     s.set_loads(loads, LoadHistory::SmoothRamp { rise_time: 1e-4 })
         .unwrap();
     s.set_extra_loads(&vec![[0.0, -1e-3, 5e-4]; n]).unwrap();
@@ -238,7 +261,10 @@ fn tet_bc_fingerprint() {
     s.run(500).unwrap();
     let e = s.energy();
     let sig = element_stresses(&mesh, &mat, s.displacement()).unwrap();
-    let s1 = sig.iter().map(max_principal_stress).fold(f64::MIN, f64::max);
+    let s1 = sig
+        .iter()
+        .map(max_principal_stress)
+        .fold(f64::MIN, f64::max);
     line(
         "tet_bc",
         &[
@@ -246,9 +272,33 @@ fn tet_bc_fingerprint() {
             ("dt", s.dt()),
             ("time", s.time()),
             ("added_mass", s.added_mass()),
-            ("u_v_hash", f64::from_bits(hash(s.displacement().iter().chain(s.velocity()).flatten().cloned()))),
-            ("f_int_hash", f64::from_bits(hash(s.internal_force().iter().flatten().cloned()))),
-            ("energy_hist_hash", f64::from_bits(hash(s.energy_history().iter().flat_map(|e| [e.time, e.kinetic, e.internal, e.external_work, e.damping_work, e.initial])))),
+            (
+                "u_v_hash",
+                f64::from_bits(hash(
+                    s.displacement()
+                        .iter()
+                        .chain(s.velocity())
+                        .flatten()
+                        .cloned(),
+                )),
+            ),
+            (
+                "f_int_hash",
+                f64::from_bits(hash(s.internal_force().iter().flatten().cloned())),
+            ),
+            (
+                "energy_hist_hash",
+                f64::from_bits(hash(s.energy_history().iter().flat_map(|e| {
+                    [
+                        e.time,
+                        e.kinetic,
+                        e.internal,
+                        e.external_work,
+                        e.damping_work,
+                        e.initial,
+                    ]
+                }))),
+            ),
             ("kinetic", e.kinetic),
             ("internal", e.internal),
             ("external_work", e.external_work),
@@ -289,8 +339,11 @@ fn shell_cluster_setup() -> (ShellModel, ShellExplicit) {
     let mut mesh = a.clone();
     let off = a.nodes.len();
     mesh.nodes.extend_from_slice(&b.nodes);
-    mesh.triangles
-        .extend(b.triangles.iter().map(|t| [t[0] + off, t[1] + off, t[2] + off]));
+    mesh.triangles.extend(
+        b.triangles
+            .iter()
+            .map(|t| [t[0] + off, t[1] + off, t[2] + off]),
+    );
     mesh.thickness.extend_from_slice(&b.thickness);
     let nn = mesh.nodes.len();
     let body: Vec<u32> = (0..nn).map(|i| u32::from(i >= off)).collect();
@@ -342,9 +395,18 @@ fn shell_report(name: &str, model: &ShellModel, s: &ShellExplicit) {
             ("steps", s.steps() as f64),
             ("dt", s.dt()),
             ("time", s.time()),
-            ("u_v_hash", f64::from_bits(hash(s.displacement().iter().chain(s.velocity()).cloned()))),
-            ("f_contact_hash", f64::from_bits(hash(s.contact_force().iter().flatten().cloned()))),
-            ("contact_hist_hash", f64::from_bits(hash(c.history().iter().cloned()))),
+            (
+                "u_v_hash",
+                f64::from_bits(hash(s.displacement().iter().chain(s.velocity()).cloned())),
+            ),
+            (
+                "f_contact_hash",
+                f64::from_bits(hash(s.contact_force().iter().flatten().cloned())),
+            ),
+            (
+                "contact_hist_hash",
+                f64::from_bits(hash(c.history().iter().cloned())),
+            ),
             ("kinetic", e.kinetic),
             ("internal", e.internal),
             ("load_work", e.load_work),
@@ -395,7 +457,9 @@ fn shell_fixed_fingerprint() {
     s.set_loads(&model.area_load([0.0, 0.0, -1e4])).unwrap();
     s.add_gravity([0.0, 0.0, -9.81]).unwrap();
     let nd = 6 * mesh.nodes.len();
-    let u0: Vec<f64> = (0..nd).map(|d| if d % 6 == 2 { 1e-8 } else { 0.0 }).collect();
+    let u0: Vec<f64> = (0..nd)
+        .map(|d| if d % 6 == 2 { 1e-8 } else { 0.0 })
+        .collect();
     s.set_initial_displacement(&u0).unwrap();
     let v0: Vec<f64> = (0..nd)
         .map(|d| {
@@ -417,7 +481,10 @@ fn shell_fixed_fingerprint() {
             ("steps", s.steps() as f64),
             ("dt", s.dt()),
             ("time", s.time()),
-            ("u_v_hash", f64::from_bits(hash(s.displacement().iter().chain(s.velocity()).cloned()))),
+            (
+                "u_v_hash",
+                f64::from_bits(hash(s.displacement().iter().chain(s.velocity()).cloned())),
+            ),
             ("kinetic", e.kinetic),
             ("internal", e.internal),
             ("load_work", e.load_work),
@@ -437,8 +504,7 @@ fn dem_fingerprint(name: &str, law: DemLaw, steps: u64) {
     if let DemLaw::HertzReissnerMindlin = law {
         for m in scene.materials.iter_mut() {
             m.shell_stiffness =
-                demfem::contact::reissner_stiffness(1e8, m.poisson_ratio, 1.1e-3, 5.25e-3)
-                    .unwrap();
+                demfem::contact::reissner_stiffness(1e8, m.poisson_ratio, 1.1e-3, 5.25e-3).unwrap();
         }
     }
     scene.model = law;

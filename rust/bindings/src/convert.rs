@@ -242,17 +242,18 @@ pub(crate) fn idx_arr<'py, const K: usize>(
     Ok(a.into_pyarray(py))
 }
 
-
 /// Ids per node (`n` of them, each in [0, 2^32)), e.g. the body or region of each node.
 pub(crate) fn ids(a: &PyReadonlyArray1<'_, i64>, field: &str, n: usize) -> PyResult<Vec<u32>> {
     let v = a.as_array();
     if v.len() != n {
-        return Err(shape_err(field, format!("{} entries for {n} nodes", v.len())));
+        return Err(shape_err(
+            field,
+            format!("{} entries for {n} nodes", v.len()),
+        ));
     }
     v.iter()
         .map(|&x| {
-            u32::try_from(x)
-                .map_err(|_| invalid(field, &x.to_string(), "integers in [0, 2^32)"))
+            u32::try_from(x).map_err(|_| invalid(field, &x.to_string(), "integers in [0, 2^32)"))
         })
         .collect()
 }

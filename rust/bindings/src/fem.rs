@@ -88,8 +88,7 @@ fn fem_tet_mesh<'py>(
                 &format!("a whole number >= {lo}"),
             ));
         }
-        usize::try_from(v)
-            .map_err(|_| invalid(field, &v.to_string(), "a whole number that fits"))
+        usize::try_from(v).map_err(|_| invalid(field, &v.to_string(), "a whole number that fits"))
     };
     let n_theta = whole("n_theta", n_theta, 3)?;
     let n_layers = whole("n_layers", n_layers, 1)?;

@@ -332,9 +332,8 @@ impl RigidSimulation {
     #[pyo3(signature = (t_end, chunk=2000))]
     fn run_until(&mut self, py: Python<'_>, t_end: f64, chunk: i64) -> PyResult<u64> {
         let n = steps_until(t_end, self.scene.time(), self.scene.time_step())?;
-        let steps = i64::try_from(n).map_err(|_| {
-            invalid("t_end", &t_end.to_string(), "reachable in < 2^63 steps")
-        })?;
+        let steps = i64::try_from(n)
+            .map_err(|_| invalid("t_end", &t_end.to_string(), "reachable in < 2^63 steps"))?;
         self.step(py, steps, chunk)?;
         Ok(n)
     }

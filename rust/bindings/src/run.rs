@@ -97,4 +97,3 @@ pub(crate) fn checked_steps(n: i64, time: f64, dt: f64) -> PyResult<u64> {
     }
     Ok(n)
 }
-

@@ -30,12 +30,12 @@ use crate::fem::assembly::lumped_mass;
 use crate::fem::contact::{ContactEnergy, ContactModel};
 use crate::fem::material::LinearElastic;
 use crate::fem::mesh::{tet_quality, TetMesh};
-use crate::fem::tet_forces::TetForceKernel;
 use crate::fem::reduce::{det_sum, NODE_CHUNK};
 use crate::fem::stable_step::{
     certified_eigenvalue_bound, critical_step_from_eigenvalue, mass_scaling_factors,
     EigenvalueBound, StepBound,
 };
+use crate::fem::tet_forces::TetForceKernel;
 
 /// Time history multiplying nodal loads or prescribed displacements.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -21,4 +21,3 @@ pub(crate) fn det_sum<F: Fn(usize) -> f64 + Sync>(n: usize, f: F) -> f64 {
         .collect();
     partial.iter().sum()
 }
-

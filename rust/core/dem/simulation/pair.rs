@@ -4,8 +4,8 @@
 //! kernel of one pair. [`super::chunk`] runs it over a block.
 
 use super::law::{law_at, tangential_force, ContactConst};
-use super::state::{Flips, PairContact, PairDetail, PairOut};
 use super::on;
+use super::state::{Flips, PairContact, PairDetail, PairOut};
 use crate::dem::effects::{Effect, EffectSet};
 use crate::dem::material::{ContactModel, PairLaw};
 use crate::geometry::Vec3;

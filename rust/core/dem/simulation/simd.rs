@@ -6,8 +6,8 @@
 //! needs around glam's three-component vectors.
 
 use super::batch::Batch;
-use super::gather::{particle_chunk, ParticleCtx};
 use super::chunk::{pair_chunk, wall_chunk};
+use super::gather::{particle_chunk, ParticleCtx};
 use super::pair::{PairCtx, PairLists};
 use super::state::{Flips, PairContact, WallContact, WallDetail, WallOut};
 use super::wall::{BlockWalls, WallCtx};

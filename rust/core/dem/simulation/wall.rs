@@ -4,9 +4,9 @@
 //! kernel of one slot. [`super::chunk`] runs it over the slots of a block.
 
 use super::law::{law_at, tangential_force};
+use super::on;
 use super::pair::PairCtx;
 use super::state::{WallContact, WallDetail, WallOut, WallState};
-use super::on;
 use crate::dem::effects::{Effect, EffectSet};
 use crate::geometry::{rotate_about, Vec3, Wall, WallMotion, WallShape};
 
