@@ -4,8 +4,8 @@
 //! Also prints the one-off set-up cost of the two critical-step bounds, and measures
 //! shell (CST + DKT triangle) element-updates per second on the cartridge mid-surface.
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use demfem::fem::explicit::TetForceKernel;
 use demfem::fem::stable_step::StepBound;
+use demfem::fem::tet_forces::TetForceKernel;
 use demfem::fem::{
     AxisymmetricProfile, ExplicitConfig, ExplicitSolver, LinearElastic, LoadHistory, Prescribed,
 };

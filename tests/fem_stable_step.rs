@@ -1,8 +1,9 @@
 //! Critical time step: the element eigenvalue bound against exact results.
 
-use demfem::fem::explicit::{global_max_eigenvalue, TetForceKernel};
 use demfem::fem::mesh::{AxisymmetricProfile, TetMesh};
 use demfem::fem::stable_step::element_eigenvalue_bound;
+use demfem::fem::stable_step::global_max_eigenvalue;
+use demfem::fem::tet_forces::TetForceKernel;
 use demfem::fem::{ExplicitConfig, ExplicitSolver, LinearElastic};
 use demfem::DemfemError;
 use nalgebra::{DMatrix, SymmetricEigen};

@@ -4,130 +4,25 @@
 
 use std::path::PathBuf;
 
-use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
+use numpy::{IntoPyArray, PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
-use demfem::dem::{ContactModel, EffectSet, Material, ParticleInit, Partner, Scene, Simulation};
+use demfem::dem::{ContactModel, EffectSet, Material, ParticleInit, Scene, Simulation};
 use demfem::geometry::Vec3;
-use demfem::DemfemError;
 
+use crate::convert::{
+    array_n3, as_float_array, as_int_array, count, flat3, float1, float2, get_f64, int1,
+    set_partner_columns, vec3s,
+};
+use crate::dem_events::event_columns;
 use crate::dem_walls::parse_wall;
-use crate::{CoreResult, PyDemfemError};
-
-pub(crate) fn shape_err(field: &str, detail: String) -> PyErr {
-    PyDemfemError::from(DemfemError::ShapeMismatch {
-        field: field.into(),
-        detail,
-    })
-    .into()
-}
-
-pub(crate) fn invalid(field: &str, value: &str, allowed: &str) -> PyErr {
-    PyDemfemError::from(DemfemError::InvalidParameter {
-        field: field.into(),
-        value: value.into(),
-        allowed: allowed.into(),
-    })
-    .into()
-}
+use crate::error::{invalid, shape_err, CoreResult, PyDemfemError};
+use crate::run::{checked_steps, run_in_chunks, steps_until};
 
 /// Largest time step a DEM simulation accepts, s: with no particles (or no stiffness) the
 /// stable limit is infinite, and a step beyond this is a mistake, not a DEM step.
 pub(crate) const MAX_DT: f64 = 1.0;
-
-/// A converted array (see [`crate::as_float_array`]) as a 2-D float64 view.
-pub(crate) fn float2<'py>(
-    a: &Bound<'py, PyAny>,
-    field: &str,
-) -> PyResult<PyReadonlyArray2<'py, f64>> {
-    a.extract().map_err(|_| {
-        shape_err(
-            field,
-            format!("expected a 2-D array (N, 3), got {} dimensions", ndim(a)),
-        )
-    })
-}
-
-/// A converted array as a 1-D float64 view.
-pub(crate) fn float1<'py>(
-    a: &Bound<'py, PyAny>,
-    field: &str,
-) -> PyResult<PyReadonlyArray1<'py, f64>> {
-    a.extract().map_err(|_| {
-        shape_err(
-            field,
-            format!("expected a 1-D array, got {} dimensions", ndim(a)),
-        )
-    })
-}
-
-/// A converted integer array as a 1-D int64 view.
-pub(crate) fn int1<'py>(
-    a: &Bound<'py, PyAny>,
-    field: &str,
-) -> PyResult<PyReadonlyArray1<'py, i64>> {
-    a.extract().map_err(|_| {
-        shape_err(
-            field,
-            format!("expected a 1-D array, got {} dimensions", ndim(a)),
-        )
-    })
-}
-
-fn ndim(a: &Bound<'_, PyAny>) -> usize {
-    a.getattr("ndim").and_then(|d| d.extract()).unwrap_or(0)
-}
-
-/// Steps `n` (from Python, signed) checked: >= 0, and the simulated time after them finite.
-pub(crate) fn checked_steps(n: i64, time: f64, dt: f64) -> PyResult<u64> {
-    let n = crate::count("n", n)?;
-    if !(time + n as f64 * dt).is_finite() {
-        return Err(invalid(
-            "n",
-            &n.to_string(),
-            &format!("few enough steps of dt = {dt:e} s that the simulated time stays finite"),
-        ));
-    }
-    Ok(n)
-}
-
-pub(crate) fn vec3s(
-    field: &str,
-    a: &PyReadonlyArray2<'_, f64>,
-    n: Option<usize>,
-) -> PyResult<Vec<Vec3>> {
-    let v = a.as_array();
-    let s = v.shape();
-    if s[1] != 3 || n.is_some_and(|n| n != s[0]) {
-        return Err(shape_err(
-            field,
-            format!(
-                "expected ({}, 3), got ({}, {})",
-                n.map_or("N".into(), |n| n.to_string()),
-                s[0],
-                s[1]
-            ),
-        ));
-    }
-    Ok(v.outer_iter()
-        .map(|r| Vec3::new(r[0], r[1], r[2]))
-        .collect())
-}
-
-pub(crate) fn get_f64(
-    d: &Bound<'_, PyDict>,
-    key: &str,
-    default: Option<f64>,
-    what: &str,
-) -> PyResult<f64> {
-    match d.get_item(key)? {
-        Some(v) => v
-            .extract::<f64>()
-            .map_err(|_| invalid(&format!("{what}.{key}"), &v.to_string(), "a number")),
-        None => default.ok_or_else(|| invalid(&format!("{what}.{key}"), "missing", "required")),
-    }
-}
 
 fn parse_material(d: &Bound<'_, PyDict>, k: usize) -> PyResult<Material> {
     let w = format!("materials[{k}]");
@@ -140,18 +35,6 @@ fn parse_material(d: &Bound<'_, PyDict>, k: usize) -> PyResult<Material> {
         rolling_friction: get_f64(d, "rolling_friction", Some(0.0), &w)?,
         shell_stiffness: get_f64(d, "shell_stiffness", Some(f64::INFINITY), &w)?,
     })
-}
-
-fn flat3(v: &[Vec3]) -> Vec<f64> {
-    let mut out = Vec::with_capacity(3 * v.len());
-    for x in v {
-        out.extend([x.x, x.y, x.z]);
-    }
-    out
-}
-
-pub(crate) fn array_n3<'py>(py: Python<'py>, v: &[Vec3]) -> PyResult<Bound<'py, PyAny>> {
-    Ok(flat3(v).into_pyarray(py).reshape([v.len(), 3])?.into_any())
 }
 
 /// Most neighbour-grid cells (of one particle diameter) the particle centres may span along
@@ -252,7 +135,7 @@ impl DemSimulation {
         }
         let threads = usize::try_from(threads)
             .map_err(|_| invalid("threads", &threads.to_string(), "a whole number >= 1"))?;
-        let record_every = crate::count("record_every", record_every)?;
+        let record_every = count("record_every", record_every)?;
         if let Some(step) = dt {
             if !(step.is_finite() && step > 0.0 && step <= MAX_DT) {
                 return Err(invalid(
@@ -262,10 +145,10 @@ impl DemSimulation {
                 ));
             }
         }
-        let positions = float2(&crate::as_float_array(positions, "positions")?, "positions")?;
+        let positions = float2(&as_float_array(positions, "positions")?, "positions")?;
         let position = vec3s("positions", &positions, None)?;
         let n = position.len();
-        let radii = float1(&crate::as_float_array(radii, "radii")?, "radii")?;
+        let radii = float1(&as_float_array(radii, "radii")?, "radii")?;
         let radius: Vec<f64> = radii.as_array().to_vec();
         if radius.len() != n {
             return Err(shape_err(
@@ -276,18 +159,18 @@ impl DemSimulation {
         check_grid_extent(&position, &radius)?;
         let mut p = ParticleInit::at_rest(position, radius);
         if let Some(v) = velocities {
-            let v = float2(&crate::as_float_array(v, "velocities")?, "velocities")?;
+            let v = float2(&as_float_array(v, "velocities")?, "velocities")?;
             p.velocity = vec3s("velocities", &v, Some(n))?;
         }
         if let Some(w) = angular_velocities {
             let w = float2(
-                &crate::as_float_array(w, "angular_velocities")?,
+                &as_float_array(w, "angular_velocities")?,
                 "angular_velocities",
             )?;
             p.angular_velocity = vec3s("angular_velocities", &w, Some(n))?;
         }
         if let Some(m) = material_ids {
-            let m = int1(&crate::as_int_array(m, "material_ids")?, "material_ids")?;
+            let m = int1(&as_int_array(m, "material_ids")?, "material_ids")?;
             let m = m.as_array();
             if m.len() != n {
                 return Err(shape_err(
@@ -303,7 +186,7 @@ impl DemSimulation {
                 .collect::<PyResult<_>>()?;
         }
         if let Some(t) = tags {
-            let t = int1(&crate::as_int_array(t, "tags")?, "tags")?;
+            let t = int1(&as_int_array(t, "tags")?, "tags")?;
             let t = t.as_array();
             if t.len() != n {
                 return Err(shape_err(
@@ -424,8 +307,8 @@ impl DemSimulation {
     #[pyo3(signature = (n, chunk=2000))]
     fn step(&mut self, py: Python<'_>, n: i64, chunk: i64) -> PyResult<()> {
         let n = checked_steps(n, self.sim.time(), self.sim.dt())?;
-        let chunk = crate::count("chunk", chunk)?;
-        crate::run_in_chunks(
+        let chunk = count("chunk", chunk)?;
+        run_in_chunks(
             py,
             &mut self.sim,
             n,
@@ -439,7 +322,7 @@ impl DemSimulation {
     /// Advance until the simulated time reaches `t_end` (s); returns the steps taken.
     #[pyo3(signature = (t_end, chunk=2000))]
     fn run_until(&mut self, py: Python<'_>, t_end: f64, chunk: i64) -> PyResult<u64> {
-        let n = crate::steps_until(t_end, self.sim.time(), self.sim.dt())?;
+        let n = steps_until(t_end, self.sim.time(), self.sim.dt())?;
         let steps = i64::try_from(n)
             .map_err(|_| invalid("t_end", &t_end.to_string(), "reachable in < 2^63 steps"))?;
         self.step(py, steps, chunk)?;
@@ -705,12 +588,12 @@ impl DemSimulation {
     /// onset speeds, positions, peak_normal_force, normal_impulse, peak_tangential_force,
     /// max_overlap, complete), SI units.
     fn events<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        crate::dem_events::event_columns(py, self.sim.events())
+        event_columns(py, self.sim.events())
     }
 
     /// The contacts open now, as events so far (`complete` False); the log is unchanged.
     fn open_events<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        crate::dem_events::event_columns(py, &self.sim.open_events())
+        event_columns(py, &self.sim.open_events())
     }
 
     /// Drop recorded frames, onsets and events.
@@ -766,23 +649,6 @@ impl DemSimulation {
 }
 
 impl DemSimulation {}
-
-/// The `partner` (index) and `partner_is_wall` columns of an onset or contact table.
-pub(crate) fn set_partner_columns(
-    py: Python<'_>,
-    d: &Bound<'_, PyDict>,
-    partners: impl Iterator<Item = Partner>,
-) -> PyResult<()> {
-    let (partner, is_wall): (Vec<u32>, Vec<bool>) = partners
-        .map(|p| match p {
-            Partner::Particle(j) => (j, false),
-            Partner::Wall(w) => (w, true),
-        })
-        .unzip();
-    d.set_item("partner", partner.into_pyarray(py))?;
-    d.set_item("partner_is_wall", is_wall.into_pyarray(py))?;
-    Ok(())
-}
 
 /// Register the DEM classes on the extension module.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

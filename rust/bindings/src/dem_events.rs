@@ -6,7 +6,7 @@ use pyo3::types::PyDict;
 
 use demfem::dem::ContactEvent;
 
-use crate::dem::{array_n3, set_partner_columns};
+use crate::convert::{array_n3, set_partner_columns};
 
 /// Columns: time (s, first step in contact), duration (s), particle, partner,
 /// partner_is_wall, normal_speed and tangential_speed at onset (m/s), position and

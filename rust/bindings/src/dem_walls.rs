@@ -8,8 +8,8 @@ use pyo3::types::PyDict;
 use demfem::geometry::{MeshWall, Vec3, Wall, WallMotion, WallShape};
 use demfem::DemfemError;
 
-use crate::dem::{float2, get_f64, int1, invalid, shape_err, vec3s};
-use crate::PyDemfemError;
+use crate::convert::{as_float_array, as_int_array, float2, get_f64, int1, vec3s};
+use crate::error::{invalid, shape_err, PyDemfemError};
 
 fn get_vec3(d: &Bound<'_, PyDict>, key: &str, default: Option<Vec3>, what: &str) -> PyResult<Vec3> {
     match d.get_item(key)? {
@@ -170,14 +170,14 @@ fn parse_mesh(d: &Bound<'_, PyDict>, w: &str) -> Result<WallShape, DemfemError> 
         .get_item("vertices")
         .map_err(py_err)?
         .ok_or_else(|| required(&vf))?;
-    let v = crate::as_float_array(&v, &vf).map_err(py_err)?;
+    let v = as_float_array(&v, &vf).map_err(py_err)?;
     let v = float2(&v, &vf).map_err(py_err)?;
     let vertices = vec3s(&vf, &v, None).map_err(py_err)?;
     let t = d
         .get_item("triangles")
         .map_err(py_err)?
         .ok_or_else(|| required(&tf))?;
-    let t = crate::as_int_array(&t, &tf).map_err(py_err)?;
+    let t = as_int_array(&t, &tf).map_err(py_err)?;
     let shape: Vec<usize> = t
         .getattr("shape")
         .and_then(|s| s.extract())
@@ -227,7 +227,7 @@ fn parse_mesh(d: &Bound<'_, PyDict>, w: &str) -> Result<WallShape, DemfemError> 
     let mesh = match d.get_item("triangle_velocities").map_err(py_err)? {
         Some(tv) if !tv.is_none() => {
             let f = format!("{w}.triangle_velocities");
-            let tv = crate::as_float_array(&tv, &f).map_err(py_err)?;
+            let tv = as_float_array(&tv, &f).map_err(py_err)?;
             let tv = float2(&tv, &f).map_err(py_err)?;
             let tv = vec3s(&f, &tv, Some(triangles.len())).map_err(py_err)?;
             MeshWall::with_triangle_velocities(vertices, triangles, tv)

@@ -15,30 +15,11 @@ use demfem::fem::{
 };
 use demfem::DemfemError;
 
+use crate::convert::{arr3, arr6, idx_arr, rows3, Nodes};
+use crate::error::{invalid, shape_err, PyDemfemError};
 use crate::fem_contact::{self, PyRigid};
-use crate::PyDemfemError;
+use crate::run::run_in_chunks;
 use demfem::fem::contact::ContactSettings;
-
-pub(crate) type Nodes<'py> = Bound<'py, PyArray2<f64>>;
-
-pub(crate) fn shape_err(field: &str, detail: String) -> PyErr {
-    PyDemfemError::from(DemfemError::ShapeMismatch {
-        field: field.into(),
-        detail,
-    })
-    .into()
-}
-
-pub(crate) fn rows3(a: &PyReadonlyArray2<'_, f64>, field: &str) -> PyResult<Vec<[f64; 3]>> {
-    let v = a.as_array();
-    if v.ncols() != 3 {
-        return Err(shape_err(
-            field,
-            format!("expected shape (n, 3), got {:?}", v.shape()),
-        ));
-    }
-    Ok(v.rows().into_iter().map(|r| [r[0], r[1], r[2]]).collect())
-}
 
 fn to_mesh(
     nodes: &PyReadonlyArray2<'_, f64>,
@@ -64,30 +45,6 @@ fn to_mesh(
     mesh.orient();
     mesh.validate().map_err(PyDemfemError::from)?;
     Ok(mesh)
-}
-
-pub(crate) fn arr3<'py>(py: Python<'py>, v: &[[f64; 3]]) -> PyResult<Nodes<'py>> {
-    let flat: Vec<f64> = v.iter().flatten().cloned().collect();
-    let a = Array2::from_shape_vec((v.len(), 3), flat)
-        .map_err(|e| shape_err("array", e.to_string()))?;
-    Ok(a.into_pyarray(py))
-}
-
-fn arr6<'py>(py: Python<'py>, v: &[[f64; 6]]) -> PyResult<Nodes<'py>> {
-    let flat: Vec<f64> = v.iter().flatten().cloned().collect();
-    let a = Array2::from_shape_vec((v.len(), 6), flat)
-        .map_err(|e| shape_err("array", e.to_string()))?;
-    Ok(a.into_pyarray(py))
-}
-
-fn idx_arr<'py, const K: usize>(
-    py: Python<'py>,
-    v: &[[usize; K]],
-) -> PyResult<Bound<'py, PyArray2<i64>>> {
-    let flat: Vec<i64> = v.iter().flatten().map(|&i| i as i64).collect();
-    let a = Array2::from_shape_vec((v.len(), K), flat)
-        .map_err(|e| shape_err("array", e.to_string()))?;
-    Ok(a.into_pyarray(py))
 }
 
 fn profile(
@@ -125,14 +82,13 @@ fn fem_tet_mesh<'py>(
     // signed, so a negative count is refused by name instead of pyo3's OverflowError
     let whole = |field: &str, v: i64, lo: i64| -> PyResult<usize> {
         if v < lo {
-            return Err(crate::dem::invalid(
+            return Err(invalid(
                 field,
                 &v.to_string(),
                 &format!("a whole number >= {lo}"),
             ));
         }
-        usize::try_from(v)
-            .map_err(|_| crate::dem::invalid(field, &v.to_string(), "a whole number that fits"))
+        usize::try_from(v).map_err(|_| invalid(field, &v.to_string(), "a whole number that fits"))
     };
     let n_theta = whole("n_theta", n_theta, 3)?;
     let n_layers = whole("n_layers", n_layers, 1)?;
@@ -436,7 +392,7 @@ impl FemTetSolver {
         chunk: u64,
         progress: Option<Bound<'_, PyAny>>,
     ) -> PyResult<()> {
-        crate::run_in_chunks(
+        run_in_chunks(
             py,
             &mut self.inner,
             n_steps,
@@ -696,6 +652,5 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fem_stress_invariants, m)?)?;
     m.add_function(wrap_pyfunction!(fem_ball_mesh, m)?)?;
     m.add_class::<FemTetSolver>()?;
-    m.add_class::<crate::fem_shell::FemShellSolver>()?;
     Ok(())
 }

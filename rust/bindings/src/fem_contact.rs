@@ -11,32 +11,8 @@ use demfem::fem::contact::{
 use demfem::fem::{LinearElastic, TetMesh, TriMesh};
 use demfem::DemfemError;
 
-use crate::PyDemfemError;
-
-fn err(e: DemfemError) -> PyErr {
-    PyDemfemError::from(e).into()
-}
-
-fn ids(a: &PyReadonlyArray1<'_, i64>, field: &str, n: usize) -> PyResult<Vec<u32>> {
-    let v = a.as_array();
-    if v.len() != n {
-        return Err(err(DemfemError::ShapeMismatch {
-            field: field.into(),
-            detail: format!("{} entries for {n} nodes", v.len()),
-        }));
-    }
-    v.iter()
-        .map(|&x| {
-            u32::try_from(x).map_err(|_| {
-                err(DemfemError::InvalidParameter {
-                    field: field.into(),
-                    value: x.to_string(),
-                    allowed: "integers in [0, 2^32)".into(),
-                })
-            })
-        })
-        .collect()
-}
+use crate::convert::ids;
+use crate::error::core_err as err;
 
 fn vec3(t: [f64; 3]) -> [f64; 3] {
     t

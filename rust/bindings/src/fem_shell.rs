@@ -11,13 +11,10 @@ use demfem::fem::shell::{ShellExplicit, ShellModel};
 use demfem::fem::{LinearElastic, TriMesh};
 use demfem::DemfemError;
 
-use crate::fem::{arr3, rows3, shape_err, Nodes};
+use crate::convert::{arr3, rows3, Nodes};
+use crate::error::{core_err as e, shape_err};
 use crate::fem_contact::{self, PyRigid};
-use crate::PyDemfemError;
-
-fn e(err: DemfemError) -> PyErr {
-    PyDemfemError::from(err).into()
-}
+use crate::run::run_in_chunks;
 
 /// Explicit dynamics of shell bodies in contact.
 #[pyclass(module = "demfem._core")]
@@ -178,7 +175,7 @@ impl FemShellSolver {
         chunk: u64,
         progress: Option<Bound<'_, PyAny>>,
     ) -> PyResult<()> {
-        crate::run_in_chunks(
+        run_in_chunks(
             py,
             &mut self.inner,
             n_steps,
@@ -329,4 +326,10 @@ impl FemShellSolver {
             .collect();
         arr3(py, &n)
     }
+}
+
+/// Register the shell solver class on the extension module.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<FemShellSolver>()?;
+    Ok(())
 }

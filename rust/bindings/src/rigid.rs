@@ -19,9 +19,10 @@ use demfem::rigid::{
 };
 use demfem::DemfemError;
 
-use crate::dem::{array_n3, get_f64, invalid, shape_err, vec3s};
+use crate::convert::{array_n3, count, get_f64, vec3s};
 use crate::dem_walls::parse_wall;
-use crate::PyDemfemError;
+use crate::error::{invalid, shape_err, PyDemfemError};
+use crate::run::{checked_steps, run_in_chunks, steps_until};
 
 /// Effects a rigid scene can run (the table's, without "planar" and "rolling_resistance").
 const RIGID_EFFECTS: [&str; 6] = [
@@ -314,9 +315,9 @@ impl RigidSimulation {
     /// raises SimulationInterrupted with the state consistent at a step boundary.
     #[pyo3(signature = (n, chunk=2000))]
     fn step(&mut self, py: Python<'_>, n: i64, chunk: i64) -> PyResult<()> {
-        let n = crate::dem::checked_steps(n, self.scene.time(), self.scene.time_step())?;
-        let chunk = crate::count("chunk", chunk)?;
-        crate::run_in_chunks(
+        let n = checked_steps(n, self.scene.time(), self.scene.time_step())?;
+        let chunk = count("chunk", chunk)?;
+        run_in_chunks(
             py,
             &mut self.scene,
             n,
@@ -330,10 +331,9 @@ impl RigidSimulation {
     /// Advance until the simulated time reaches `t_end` (s); returns the steps taken.
     #[pyo3(signature = (t_end, chunk=2000))]
     fn run_until(&mut self, py: Python<'_>, t_end: f64, chunk: i64) -> PyResult<u64> {
-        let n = crate::steps_until(t_end, self.scene.time(), self.scene.time_step())?;
-        let steps = i64::try_from(n).map_err(|_| {
-            crate::dem::invalid("t_end", &t_end.to_string(), "reachable in < 2^63 steps")
-        })?;
+        let n = steps_until(t_end, self.scene.time(), self.scene.time_step())?;
+        let steps = i64::try_from(n)
+            .map_err(|_| invalid("t_end", &t_end.to_string(), "reachable in < 2^63 steps"))?;
         self.step(py, steps, chunk)?;
         Ok(n)
     }

@@ -75,6 +75,7 @@ use std::sync::atomic::AtomicU64;
 mod api;
 mod batch;
 mod blocks;
+mod chunk;
 mod events;
 mod gather;
 mod law;

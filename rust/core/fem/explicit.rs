@@ -22,9 +22,6 @@
 //! mode. At n = 0, v^{−½} := v^0 − (Δt/2) a^0.
 
 mod state;
-mod tet_kernel;
-
-pub use tet_kernel::TetForceKernel;
 
 use rayon::prelude::*;
 
@@ -33,13 +30,12 @@ use crate::fem::assembly::lumped_mass;
 use crate::fem::contact::{ContactEnergy, ContactModel};
 use crate::fem::material::LinearElastic;
 use crate::fem::mesh::{tet_quality, TetMesh};
+use crate::fem::reduce::{det_sum, NODE_CHUNK};
 use crate::fem::stable_step::{
     certified_eigenvalue_bound, critical_step_from_eigenvalue, mass_scaling_factors,
     EigenvalueBound, StepBound,
 };
-
-/// Nodes per parallel work item.
-const NODE_CHUNK: usize = 2048;
+use crate::fem::tet_forces::TetForceKernel;
 
 /// Time history multiplying nodal loads or prescribed displacements.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -190,71 +186,6 @@ impl EnergyReport {
             0.0
         }
     }
-}
-
-/// Deterministic parallel sum over fixed chunks (independent of the thread count).
-fn det_sum<F: Fn(usize) -> f64 + Sync>(n: usize, f: F) -> f64 {
-    let n_chunks = n.div_ceil(NODE_CHUNK);
-    let partial: Vec<f64> = (0..n_chunks)
-        .into_par_iter()
-        .map(|c| {
-            let mut s = 0.0;
-            for i in c * NODE_CHUNK..((c + 1) * NODE_CHUNK).min(n) {
-                s += f(i);
-            }
-            s
-        })
-        .collect();
-    partial.iter().sum()
-}
-
-/// Largest eigenvalue of M⁻¹K (1/s²) of the assembled, unconstrained mesh by power
-/// iteration on M^{-½}KM^{-½}, using the same element kernel. The Rayleigh quotient
-/// approaches λ_max from below; `iterations` ≥ a few hundred for small meshes.
-pub fn global_max_eigenvalue(
-    kernel: &mut TetForceKernel,
-    mass: &[f64],
-    iterations: usize,
-) -> Result<f64> {
-    let n = mass.len();
-    // Deterministic, non-symmetric start vector so no mode is missing from it.
-    let mut x: Vec<[f64; 3]> = (0..n)
-        .map(|i| {
-            let s = (i as f64 * 0.7548776662).fract();
-            [s - 0.5, (s * 7.3).fract() - 0.5, (s * 13.1).fract() - 0.5]
-        })
-        .collect();
-    let mut y = vec![[0.0; 3]; n];
-    let mut tmp = vec![[0.0; 3]; n];
-    let mut lam = 0.0;
-    for _ in 0..iterations {
-        let nx = det_sum(n, |i| {
-            x[i][0] * x[i][0] + x[i][1] * x[i][1] + x[i][2] * x[i][2]
-        })
-        .sqrt();
-        if !(nx > 0.0) || !nx.is_finite() {
-            return Err(DemfemError::Numerical(
-                "power iteration vector vanished".into(),
-            ));
-        }
-        for (i, xi) in x.iter_mut().enumerate() {
-            for c in 0..3 {
-                xi[c] /= nx;
-                tmp[i][c] = xi[c] / mass[i].sqrt();
-            }
-        }
-        kernel.apply(&tmp, &mut y);
-        for (i, yi) in y.iter_mut().enumerate() {
-            for c in 0..3 {
-                yi[c] /= mass[i].sqrt();
-            }
-        }
-        lam = det_sum(n, |i| {
-            x[i][0] * y[i][0] + x[i][1] * y[i][1] + x[i][2] * y[i][2]
-        });
-        std::mem::swap(&mut x, &mut y);
-    }
-    Ok(lam)
 }
 
 /// Explicit central-difference solver for a tetrahedral mesh.

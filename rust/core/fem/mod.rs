@@ -4,8 +4,9 @@
 //! Layout (fenris style): [`mesh`] builds and checks meshes, [`element`] holds the element
 //! kernels, [`assembly`] turns element quantities into global ones (lumped mass, sparse
 //! stiffness, surface loads), [`contact`] gives bodies penalty contact with each other and
-//! with rigid surfaces, [`shell`] assembles and solves thin-shell models, [`explicit`] integrates in time, [`stable_step`] bounds the
-//! critical time step, [`static_solve`] factorises the sparse stiffness, [`stress`] recovers
+//! with rigid surfaces, [`shell`] assembles and solves thin-shell models, [`tet_forces`]
+//! computes the nodal forces of a tet mesh, [`explicit`] integrates in time,
+//! [`stable_step`] bounds the critical time step, [`static_solve`] factorises the sparse stiffness, [`stress`] recovers
 //! stresses and [`io`] writes VTK files. All quantities are SI.
 
 // `!(x > 0.0)` is deliberate throughout: it rejects NaN, which `x <= 0.0` would let through.
@@ -20,11 +21,13 @@ pub mod explicit;
 pub mod io;
 pub mod material;
 pub mod mesh;
+mod reduce;
 pub mod shell;
 pub mod stable_step;
 pub mod state_io;
 pub mod static_solve;
 pub mod stress;
+pub mod tet_forces;
 
 pub use explicit::{
     EnergyReport, ExplicitConfig, ExplicitSolver, LoadHistory, Prescribed, PrescribedKind,

@@ -1,12 +1,11 @@
-//! The pair kernels, one contact at a time (the reference the batched kernels reproduce bit
-//! for bit): their read-only context ([`PairCtx`]), the arrays of a block they write
-//! ([`PairLists`]), the reach test and the wake bound of pairs out of contact, the kernel of
-//! one pair and of one block of the pair list.
+//! The pair kernel, one contact at a time (the reference the batched kernels reproduce bit
+//! for bit): its read-only context ([`PairCtx`]), the arrays of a block it writes
+//! ([`PairLists`]), the reach test and the wake bound of pairs out of contact, and the
+//! kernel of one pair. [`super::chunk`] runs it over a block.
 
-use super::batch::{pair_chunk_batched, Batch};
 use super::law::{law_at, tangential_force, ContactConst};
+use super::on;
 use super::state::{Flips, PairContact, PairDetail, PairOut};
-use super::{on, PAIR_CHUNK};
 use crate::dem::effects::{Effect, EffectSet};
 use crate::dem::material::{ContactModel, PairLaw};
 use crate::geometry::Vec3;
@@ -124,7 +123,7 @@ pub(super) fn wake_travel(travel: f64, dist2: f64, r_sum: f64, min_skip: f64) ->
 /// Force of one candidate pair; returns whether a contact began.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn pair_kernel<const E: u16>(
+pub(super) fn pair_kernel<const E: u16>(
     p: &mut PairContact,
     active: &mut bool,
     onset_flag: &mut bool,
@@ -214,53 +213,5 @@ fn pair_kernel<const E: u16>(
     Flips {
         onsets: onset as u32,
         ends: 0,
-    }
-}
-
-/// Pair kernels of one block of the pair list (starting at a multiple of `PAIR_CHUNK`); the
-/// contacts begun and ended are added to `flips`, one entry per `PAIR_CHUNK` pairs.
-#[inline(always)]
-#[allow(clippy::too_many_arguments)]
-pub(super) fn pair_chunk<const E: u16>(
-    chunk: &mut [PairContact],
-    lists: PairLists<'_>,
-    konst: &[u32],
-    flips: &mut [Flips],
-    c: &PairCtx<'_>,
-    batch: &mut Batch,
-) {
-    if c.batched && !on::<E>(c.effects, Effect::RollingResistance) {
-        return match c.pairs_uniform {
-            Some(_) if c.avx2 => {
-                pair_chunk_batched::<E, true>(chunk, lists, konst, flips, c, batch)
-            }
-            _ => pair_chunk_batched::<E, false>(chunk, lists, konst, flips, c, batch),
-        };
-    }
-    // one at a time: every pair is tested (its wake stays a valid bound, see
-    // `Simulation::pair_wake`, as the travel keeps growing)
-    let PairLists {
-        active,
-        onset,
-        out,
-        detail,
-        rolling,
-        ..
-    } = lists;
-    for (e, ((((((p, a), s), o), d), r), k)) in chunk
-        .iter_mut()
-        .zip(active.iter_mut())
-        .zip(onset.iter_mut())
-        .zip(out.iter_mut())
-        .zip(detail.iter_mut())
-        .zip(rolling.iter_mut())
-        .zip(konst)
-        .enumerate()
-    {
-        let f = pair_kernel::<E>(p, a, s, &c.table[*k as usize], o, d, r, c);
-        if let Some(chunk_flips) = flips.get_mut(e / PAIR_CHUNK) {
-            chunk_flips.onsets += f.onsets;
-            chunk_flips.ends += f.ends;
-        }
     }
 }

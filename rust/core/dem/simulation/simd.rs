@@ -6,10 +6,11 @@
 //! needs around glam's three-component vectors.
 
 use super::batch::Batch;
+use super::chunk::{pair_chunk, wall_chunk};
 use super::gather::{particle_chunk, ParticleCtx};
-use super::pair::{pair_chunk, PairCtx, PairLists};
+use super::pair::{PairCtx, PairLists};
 use super::state::{Flips, PairContact, WallContact, WallDetail, WallOut};
-use super::wall::{wall_chunk, BlockWalls, WallCtx};
+use super::wall::{BlockWalls, WallCtx};
 use crate::geometry::Vec3;
 
 /// Whether the step may use its AVX2 build ([`crate::cpu::has_avx2`]).

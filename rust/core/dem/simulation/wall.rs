@@ -1,13 +1,12 @@
-//! The particle–wall kernels, one slot at a time (the reference the batched kernels
-//! reproduce bit for bit): their read-only context ([`WallCtx`]), a block's part of the wall
-//! lists ([`BlockWalls`]), the wall test and the wall's velocity at a contact, the kernel of
-//! one slot and of the slots of one block of particles.
+//! The particle–wall kernel, one slot at a time (the reference the batched kernels
+//! reproduce bit for bit): its read-only context ([`WallCtx`]), a block's part of the wall
+//! lists ([`BlockWalls`]), the wall test and the wall's velocity at a contact, and the
+//! kernel of one slot. [`super::chunk`] runs it over the slots of a block.
 
-use super::batch::{wall_chunk_batched, Batch, BATCH};
 use super::law::{law_at, tangential_force};
+use super::on;
 use super::pair::PairCtx;
 use super::state::{WallContact, WallDetail, WallOut, WallState};
-use super::{on, NO_WALL};
 use crate::dem::effects::{Effect, EffectSet};
 use crate::geometry::{rotate_about, Vec3, Wall, WallMotion, WallShape};
 
@@ -179,7 +178,7 @@ pub(super) fn wall_hit(
 /// contact state; flags onset.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn wall_kernel<const E: u16>(
+pub(super) fn wall_kernel<const E: u16>(
     s: &mut WallContact,
     o: &mut WallOut,
     detail: &mut WallDetail,
@@ -259,46 +258,5 @@ fn wall_kernel<const E: u16>(
             normal_force: f_n,
             ..*detail
         };
-    }
-}
-
-/// Wall kernels of the particles of one chunk starting at `first` (their slots).
-#[inline(always)]
-pub(super) fn wall_chunk<const E: u16>(
-    c: &WallCtx<'_>,
-    first: usize,
-    lists: BlockWalls<'_>,
-    slots: &mut [WallContact],
-    out: &mut [WallOut],
-    detail: &mut [WallDetail],
-    batch: &mut Batch,
-) {
-    let stride = c.wall_stride;
-    if c.shared.batched && !on::<E>(c.shared.effects, Effect::RollingResistance) && stride <= BATCH
-    {
-        wall_chunk_batched::<E>(c, first, lists, slots, out, detail, batch);
-        return;
-    }
-    for (k, ((slots, out), detail)) in slots
-        .chunks_exact_mut(stride)
-        .zip(out.chunks_exact_mut(stride))
-        .zip(detail.chunks_exact_mut(stride))
-        .enumerate()
-    {
-        let i = first + k;
-        if !c.alive[i] {
-            continue;
-        }
-        let (x, v, w) = (
-            c.shared.position[i],
-            c.shared.velocity[i],
-            c.shared.omega[i],
-        );
-        for ((s, o), d) in slots.iter_mut().zip(out.iter_mut()).zip(detail.iter_mut()) {
-            if s.wall == NO_WALL {
-                break;
-            }
-            wall_kernel::<E>(s, o, d, i, x, v, w, c);
-        }
     }
 }

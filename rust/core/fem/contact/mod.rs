@@ -46,9 +46,22 @@
 //! of both sides for body pairs) and the largest penetration, sampled every
 //! `output_interval` steps.
 
+//!
+//! **Layout.** One step ([`ContactModel::compute`]) runs, in this order: the broad phase
+//! (`broad_phase`) and the face geometry (`narrow`); the contacts of the step, narrow phase
+//! and friction against bodies (`hits`, `narrow`, `friction`) and rigid surfaces (`rigid`);
+//! their forces and the contact memory (`forces`); the step allowance check (`allowance`);
+//! the output sample (`output`); the springs (`springs`); the work and energies (`energy`).
+//! `state` saves and restores it all.
+
+mod allowance;
 mod broad_phase;
+mod energy;
+mod forces;
 mod friction;
+mod hits;
 mod narrow;
+mod output;
 mod rigid;
 mod shell_surface;
 mod springs;
@@ -57,6 +70,8 @@ mod surface;
 mod vec3;
 
 pub use broad_phase::BroadPhase;
+pub use energy::ContactEnergy;
+pub use output::ChannelSample;
 pub use rigid::{RigidShape, RigidSurface};
 pub use springs::NoTensionSpring;
 pub use surface::{Surface, SurfaceFace};
@@ -67,8 +82,7 @@ use crate::error::{check_non_negative, check_positive, DemfemError, Result};
 use crate::fem::material::LinearElastic;
 use crate::fem::mesh::TetMesh;
 
-use friction::friction_update;
-use vec3::{add, dot, norm, scale, sub};
+use vec3::add;
 
 /// Surface nodes per parallel work item (fixed, so results do not depend on the threads).
 const NODE_CHUNK: usize = 512;
@@ -127,65 +141,6 @@ impl ContactSettings {
     }
 }
 
-/// Energies of the contact model, J.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct ContactEnergy {
-    /// Elastic energy now stored in the normal and stick springs, J.
-    pub elastic: f64,
-    /// Energy now stored in the no-tension springs, J.
-    pub springs: f64,
-    /// Work dissipated by friction slip so far, J.
-    pub friction_work: f64,
-    /// Work done on the bodies by the moving rigid surfaces through contact so far, J.
-    pub rigid_work: f64,
-    /// Work done by all contact and spring forces on the nodes so far (trapezoidal rule in
-    /// displacement, as the solver counts external work), J.
-    pub contact_work: f64,
-}
-
-impl ContactEnergy {
-    /// Closure of the contact bookkeeping: contact_work + rigid_work... rearranged as
-    /// |W_c + E_el + E_springs + W_fric − W_rigid| (0 for exact time integration), J.
-    pub fn bookkeeping_error(&self) -> f64 {
-        (self.contact_work + self.elastic + self.springs + self.friction_work - self.rigid_work)
-            .abs()
-    }
-}
-
-/// One contact found in a step (internal).
-#[derive(Debug, Clone, Copy)]
-struct Hit {
-    slave: u32,
-    /// Face index, or the index of the rigid surface when `rigid`.
-    partner: u32,
-    rigid: bool,
-    weights: [f64; 3],
-    normal_force: [f64; 3],
-    tangential_force: [f64; 3],
-    stiffness: f64,
-    penetration: f64,
-    /// Depth subtracted from `penetration` in the force (see `ContactModel::offset`), m.
-    offset: f64,
-    /// Side of a shell face (±1; 1 for solids and rigid surfaces).
-    side: f64,
-    elastic: f64,
-    dissipated: f64,
-    rigid_work: f64,
-}
-
-/// Contact output of one channel at one sample.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct ChannelSample {
-    /// |Σ normal force on the lower-numbered party|, N.
-    pub normal_force: f64,
-    /// |Σ tangential force on the lower-numbered party|, N.
-    pub tangential_force: f64,
-    /// Contact area, m².
-    pub area: f64,
-    /// Largest penetration, m.
-    pub max_penetration: f64,
-}
-
 /// Contact between the bodies of one mesh and with rigid surfaces, plus ghost springs.
 #[derive(Debug, Clone)]
 pub struct ContactModel {
@@ -232,11 +187,6 @@ pub struct ContactModel {
     steps: u64,
     active: usize,
     max_gershgorin: f64,
-}
-
-fn pair_index(a: usize, b: usize, parties: usize) -> usize {
-    // a < b; row-major upper triangle.
-    a * parties - a * (a + 1) / 2 + (b - a - 1)
 }
 
 impl ContactModel {
@@ -348,27 +298,6 @@ impl ContactModel {
         Ok(())
     }
 
-    /// Number of parties (bodies then rigid surfaces).
-    pub fn parties(&self) -> usize {
-        self.n_bodies + self.rigid.len()
-    }
-    /// Number of output regions.
-    pub fn regions(&self) -> usize {
-        self.n_regions
-    }
-    /// Output channels: (party a, party b, region of a) with a < b, in output order.
-    pub fn channels(&self) -> Vec<(usize, usize, usize)> {
-        let p = self.parties();
-        let mut out = Vec::new();
-        for a in 0..p {
-            for b in a + 1..p {
-                for r in 0..self.n_regions {
-                    out.push((a, b, r));
-                }
-            }
-        }
-        out
-    }
     /// The extracted contact surface.
     pub fn surface(&self) -> &Surface {
         &self.surface
@@ -384,92 +313,6 @@ impl ContactModel {
     /// Contacts active in the last step.
     pub fn active_contacts(&self) -> usize {
         self.active
-    }
-    /// Largest Gershgorin bound of the active contact springs seen so far, 1/s².
-    pub fn max_contact_eigenvalue(&self) -> f64 {
-        self.max_gershgorin
-    }
-    /// The eigenvalue allowance certified into the step, 1/s².
-    pub fn allowance(&self) -> f64 {
-        self.allowance
-    }
-
-    /// Recorded output: rows of `1 + 4 × channels` values (time, then normal force, tangential
-    /// force, area, largest penetration per channel).
-    pub fn history(&self) -> &[f64] {
-        &self.history
-    }
-
-    /// Contact pressure of each mesh node in the last step (normal force it carries over its
-    /// tributary area), Pa; 0 off the surface.
-    pub fn pressure(&self) -> Vec<f64> {
-        let mut p = vec![0.0; self.reference.len()];
-        for (k, &i) in self.surface.nodes.iter().enumerate() {
-            p[i] = self.normal_load[k] / self.surface.node_area[k];
-        }
-        p
-    }
-
-    /// Bound on the contact's contribution to λ_max(M⁻¹K) for nodal masses `mass` (kg),
-    /// 1/s²; also fixes the masses for the per-step check.
-    pub fn eigenvalue_allowance(&mut self, mass: &[f64]) -> Result<f64> {
-        if mass.len() != self.reference.len() {
-            return Err(DemfemError::ShapeMismatch {
-                field: "mass".into(),
-                detail: format!("{} entries for {} nodes", mass.len(), self.reference.len()),
-            });
-        }
-        let sf = &self.surface;
-        // Lightest surface node of each body (the slaves a face can meet).
-        let mut min_mass = vec![f64::INFINITY; self.n_bodies];
-        for (k, &i) in sf.nodes.iter().enumerate() {
-            let b = sf.node_body[k] as usize;
-            min_mass[b] = min_mass[b].min(mass[i]);
-        }
-        let mut face_term: f64 = 0.0;
-        for f in &sf.faces {
-            let mf = f
-                .nodes
-                .iter()
-                .map(|&i| mass[i])
-                .fold(f64::INFINITY, f64::min);
-            let ms = (0..self.n_bodies)
-                .filter(|&b| b != f.body as usize)
-                .map(|b| min_mass[b])
-                .fold(f64::INFINITY, f64::min);
-            if ms.is_finite() {
-                let q = 1.0 / ms.sqrt() + 1.0 / mf.sqrt();
-                face_term = face_term.max(f.stiffness * q * q);
-            }
-        }
-        let mut rigid_term: f64 = 0.0;
-        if !self.rigid.is_empty() {
-            for (k, &i) in sf.nodes.iter().enumerate() {
-                rigid_term = rigid_term.max(sf.node_stiffness[k] / mass[i]);
-            }
-            rigid_term *= self.rigid.len().min(2) as f64;
-        }
-        let mut spring_row = vec![0.0; mass.len()];
-        for s in &self.springs {
-            spring_row[s.node] += s.stiffness / mass[s.node];
-        }
-        let spring_term = spring_row.iter().fold(0.0f64, |a, &b| a.max(b));
-        // A shell node is a slave and, at a ridge met head-on, the corner its own faces give
-        // weight 1 to another body's slave: two full-stiffness springs per node.
-        let face_term = if self.is_shell() {
-            2.0 * face_term
-        } else {
-            face_term
-        };
-        let allowance = self.settings.contacts_per_node * face_term + rigid_term + spring_term;
-        if !allowance.is_finite() {
-            return Err(DemfemError::Numerical(
-                "contact step allowance is not finite (a node of zero mass on the surface?)".into(),
-            ));
-        }
-        self.allowance = allowance;
-        self.mass = mass.to_vec();
-        Ok(allowance)
     }
 
     /// Error for bodies that overlap at the start by more than the tolerance.
@@ -526,14 +369,6 @@ impl ContactModel {
             });
     }
 
-    /// The velocity (m/s) of the point of `face` with barycentric weights `w`.
-    fn face_velocity(&self, face: &SurfaceFace, w: [f64; 3], v: &[[f64; 3]]) -> [f64; 3] {
-        add(
-            add(scale(v[face.nodes[0]], w[0]), scale(v[face.nodes[1]], w[1])),
-            scale(v[face.nodes[2]], w[2]),
-        )
-    }
-
     /// Contact and spring forces (N, added into `force`, one per node) at displacement `u`
     /// (m) and velocity `v` (m/s) at time `t` (s), for a step `dt` (s). A contact that runs
     /// away or springs that exceed the certified allowance are kept for [`Self::take_failure`].
@@ -550,277 +385,26 @@ impl ContactModel {
             self.broad.rebuild(&self.surface, &self.x, u);
         }
         self.update_face_geometry();
-        let ns = self.surface.nodes.len();
-        let nr = self.rigid.len();
-        let mu = self.settings.friction;
-        // Narrow phase and friction, in parallel over fixed chunks of surface nodes.
-        let hits: Vec<Hit> = {
-            let this = &*self;
-            let stick = &this.stick;
-            let stick_rigid = &this.stick_rigid;
-            (0..ns.div_ceil(NODE_CHUNK))
-                .into_par_iter()
-                .flat_map_iter(|c| {
-                    let k0 = c * NODE_CHUNK;
-                    let k1 = (k0 + NODE_CHUNK).min(ns);
-                    let mut out = Vec::new();
-                    for k in k0..k1 {
-                        let i = this.surface.nodes[k];
-                        if let Some((f, d, w, side, n)) = this.closest_face(k, 0.5) {
-                            let face = &this.surface.faces[f];
-                            let vf = this.face_velocity(face, w, v);
-                            let vrel = sub(v[i], vf);
-                            // A node in contact within the last few steps may come back at
-                            // any depth the face takes (it lost the face for a step at an
-                            // edge); a fresh contact is only as deep as the node and the face
-                            // closed in one step, with a margin. Deeper is not a touch (and
-                            // a sudden deep spring would inject energy).
-                            let last = this.last_contact[k];
-                            let recent = last != u64::MAX && this.steps - last <= RECENT_STEPS;
-                            let closing = 2.0 * (-dot(vrel, n)).max(0.0) * dt;
-                            let margin = 1e-6 * face.depth;
-                            let offset = if !recent {
-                                (d <= closing + margin).then_some(0.0)
-                            } else if this.contact_face[k] == f as u32 {
-                                Some(this.offset[k].min(d))
-                            } else {
-                                // Onto another face: no deeper than the last contact plus
-                                // what the node and the face closed since.
-                                let since = (this.steps - last) as f64;
-                                let allowed = this.last_depth[k] + since * closing + margin;
-                                Some((d - allowed).max(0.0))
-                            };
-                            if let Some(offset) = offset {
-                                let h = friction_update(
-                                    stick[k],
-                                    n,
-                                    vrel,
-                                    [0.0; 3],
-                                    d - offset,
-                                    face.stiffness,
-                                    mu,
-                                    dt,
-                                );
-                                out.push(Hit {
-                                    slave: k as u32,
-                                    partner: f as u32,
-                                    rigid: false,
-                                    weights: w,
-                                    normal_force: h.0,
-                                    tangential_force: h.1,
-                                    stiffness: face.stiffness,
-                                    penetration: d,
-                                    offset,
-                                    side,
-                                    elastic: h.2,
-                                    dissipated: h.3,
-                                    rigid_work: 0.0,
-                                });
-                            }
-                        }
-                        for (r, s) in this.rigid.iter().enumerate() {
-                            let hn = this.surface.node_half_thickness[k];
-                            if let Some((d, n, vs)) = s.probe_offset(this.x[i], t, hn) {
-                                let kn = this.surface.node_stiffness[k];
-                                let vrel = sub(v[i], vs);
-                                let h = friction_update(
-                                    stick_rigid[k * nr + r],
-                                    n,
-                                    vrel,
-                                    vs,
-                                    d,
-                                    kn,
-                                    s.friction,
-                                    dt,
-                                );
-                                // Power the moving surface puts into the body: F·v_s.
-                                let work = dot(add(h.0, h.1), vs) * dt;
-                                out.push(Hit {
-                                    slave: k as u32,
-                                    partner: r as u32,
-                                    rigid: true,
-                                    weights: [0.0; 3],
-                                    normal_force: h.0,
-                                    tangential_force: h.1,
-                                    stiffness: kn,
-                                    penetration: d,
-                                    offset: 0.0,
-                                    side: 1.0,
-                                    elastic: h.2,
-                                    dissipated: h.3,
-                                    rigid_work: work,
-                                });
-                            }
-                        }
-                    }
-                    out
-                })
-                .collect()
-        };
-        // Deterministic scatter, in node order. Only surface and spring nodes ever carry a
-        // force.
-        force
-            .par_chunks_mut(NODE_CHUNK)
-            .for_each(|c| c.fill([0.0; 3]));
-        for s in self.stick.iter_mut() {
-            *s = [0.0; 3];
-        }
-        for s in self.stick_rigid.iter_mut() {
-            *s = [0.0; 3];
-        }
-        for l in self.normal_load.iter_mut() {
-            *l = 0.0;
-        }
-        let parties = self.parties();
-        let n_channels = parties * parties.saturating_sub(1) / 2 * self.n_regions;
-        let record = self.steps % self.settings.output_interval as u64 == 0;
-        let mut sums = vec![[[0.0f64; 3]; 2]; if record { n_channels } else { 0 }];
-        let mut chan = vec![ChannelSample::default(); sums.len()];
-        let mut elastic = 0.0;
+        let hits = self.find_hits(v, t, dt);
+        let (new_last, elastic) = self.apply_hits(&hits, force);
         let check = !self.mass.is_empty();
         if check {
-            self.gershgorin
-                .par_chunks_mut(NODE_CHUNK)
-                .for_each(|c| c.fill(0.0));
+            self.gershgorin_of_hits(&hits);
         }
-        let mut new_last = vec![u32::MAX; ns];
-        for h in &hits {
-            let k = h.slave as usize;
-            let i = self.surface.nodes[k];
-            let total = add(h.normal_force, h.tangential_force);
-            force[i] = add(force[i], total);
-            let fnorm = norm(h.normal_force);
-            self.normal_load[k] += fnorm;
-            elastic += h.elastic;
-            self.energy.friction_work += h.dissipated;
-            self.energy.rigid_work += h.rigid_work;
-            let body = self.surface.node_body[k] as usize;
-            let (other, face_nodes) = if h.rigid {
-                let r = h.partner as usize;
-                self.stick_rigid[k * nr + r] = h.tangential_force;
-                (self.n_bodies + r, None)
-            } else {
-                let face = self.surface.faces[h.partner as usize];
-                self.stick[k] = h.tangential_force;
-                new_last[k] = h.partner;
-                self.last_contact[k] = self.steps;
-                self.contact_face[k] = h.partner;
-                self.side[k] = h.side;
-                self.last_depth[k] = h.penetration - h.offset;
-                self.offset[k] = h.offset;
-                for (j, &node) in face.nodes.iter().enumerate() {
-                    force[node] = sub(force[node], scale(total, h.weights[j]));
-                    let sl = self.surface.slot[node] as usize;
-                    self.normal_load[sl] += fnorm * h.weights[j];
-                }
-                (face.body as usize, Some(face))
-            };
-            if check {
-                let mi = 1.0 / self.mass[i].sqrt();
-                match face_nodes {
-                    None => self.gershgorin[i] += h.stiffness * mi * mi,
-                    Some(face) => {
-                        let s: f64 = mi
-                            + (0..3)
-                                .map(|j| h.weights[j].abs() / self.mass[face.nodes[j]].sqrt())
-                                .sum::<f64>();
-                        self.gershgorin[i] += h.stiffness * mi * s;
-                        for j in 0..3 {
-                            let node = face.nodes[j];
-                            self.gershgorin[node] +=
-                                h.stiffness * h.weights[j].abs() / self.mass[node].sqrt() * s;
-                        }
-                    }
-                }
-            }
-            if record {
-                // Output on the lower-numbered party, in its region.
-                let (a, b, sign, region) = if body < other {
-                    (body, other, 1.0, self.region[i] as usize)
-                } else {
-                    let face = face_nodes.map(|f| {
-                        let j = (0..3)
-                            .max_by(|&x, &y| h.weights[x].total_cmp(&h.weights[y]))
-                            .unwrap_or(0);
-                        f.nodes[j]
-                    });
-                    (
-                        other,
-                        body,
-                        -1.0,
-                        face.map_or(0, |n| self.region[n] as usize),
-                    )
-                };
-                let c = pair_index(a, b, parties) * self.n_regions + region;
-                sums[c][0] = add(sums[c][0], scale(h.normal_force, sign));
-                sums[c][1] = add(sums[c][1], scale(h.tangential_force, sign));
-                let half = if face_nodes.is_some() { 0.5 } else { 1.0 };
-                chan[c].area += half * self.surface.node_area[k];
-                chan[c].max_penetration = chan[c].max_penetration.max(h.penetration);
-            }
-        }
+        let record = self.steps % self.settings.output_interval as u64 == 0;
+        let sample = record.then(|| self.sample_hits(&hits));
         self.check_runaway(&new_last, t);
         self.last_face = new_last;
-        // No-tension springs.
-        let mut spring_energy = 0.0;
-        for s in &self.springs {
-            let (f, e) = s.force(self.x[s.node]);
-            force[s.node] = add(force[s.node], f);
-            spring_energy += e;
-            if check && e > 0.0 {
-                self.gershgorin[s.node] += s.stiffness / self.mass[s.node];
-            }
-        }
+        let spring_energy = self.spring_forces(force, check);
         if check {
-            let g = self.gershgorin.par_iter().cloned().reduce(|| 0.0, f64::max);
-            self.max_gershgorin = self.max_gershgorin.max(g);
-            if g > self.allowance * (1.0 + 1e-12) && self.failure.is_none() {
-                self.failure = Some(DemfemError::Numerical(format!(
-                    "at t = {t:e} s the active contact springs need an eigenvalue allowance of {g:e} 1/s², above the {:e} 1/s² certified in the step; raise contacts_per_node or lower penalty_scale",
-                    self.allowance
-                )));
-            }
+            self.check_allowance(t);
         }
-        // Work of all contact forces on the nodes, as the solver counts external work
-        // (other nodes carry no force and add nothing), summed per fixed chunk.
-        let partial: Vec<f64> = self
-            .u_prev
-            .par_chunks_mut(NODE_CHUNK)
-            .zip(self.f_prev.par_chunks_mut(NODE_CHUNK))
-            .zip(u.par_chunks(NODE_CHUNK))
-            .zip(force.par_chunks(NODE_CHUNK))
-            .map(|(((up, fp), u), f)| {
-                let mut w = 0.0;
-                for (((up, fp), u), f) in up.iter_mut().zip(fp.iter_mut()).zip(u).zip(f) {
-                    for d in 0..3 {
-                        w += 0.5 * (u[d] - up[d]) * (fp[d] + f[d]);
-                    }
-                    *up = *u;
-                    *fp = *f;
-                }
-                w
-            })
-            .collect();
-        let w: f64 = partial.iter().sum();
-        if self.steps > 0 {
-            self.energy.contact_work += w;
-        }
+        self.account_work(u, force);
         self.energy.elastic = elastic;
         self.energy.springs = spring_energy;
         self.active = hits.len();
-        if record {
-            self.history.push(t);
-            for (c, s) in chan.iter_mut().enumerate() {
-                s.normal_force = norm(sums[c][0]);
-                s.tangential_force = norm(sums[c][1]);
-                self.history.extend_from_slice(&[
-                    s.normal_force,
-                    s.tangential_force,
-                    s.area,
-                    s.max_penetration,
-                ]);
-            }
-            self.sample = chan;
+        if let Some((sums, chan)) = sample {
+            self.record_sample(t, &sums, chan);
         }
         self.steps += 1;
     }
@@ -829,10 +413,5 @@ impl ContactModel {
     /// allowance); taking it clears it.
     pub fn take_failure(&mut self) -> Option<DemfemError> {
         self.failure.take()
-    }
-
-    /// The last recorded sample, one entry per channel.
-    pub fn last_sample(&self) -> &[ChannelSample] {
-        &self.sample
     }
 }

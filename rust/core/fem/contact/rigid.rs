@@ -1,10 +1,16 @@
 //! Rigid surfaces the FEM bodies can touch: a plane with a surface velocity (the belt),
 //! a sphere and an infinite cylinder (for verification), each with its own Coulomb
 //! friction coefficient. A rigid surface is a party of the contact output like a body.
+//! [`ContactModel::rigid_hits`] finds a surface node's contacts with them: F = k_node d
+//! along the surface's normal, k_node = Σ k_f/3 over the node's faces, met half the node's
+//! thickness early on a shell, with the stick spring against the surface's material.
 
 use crate::error::{check_non_negative, check_positive, DemfemError, Result};
 
-use super::vec3::{dot, norm, scale, sub};
+use super::friction::friction_update;
+use super::hits::Hit;
+use super::vec3::{add, dot, norm, scale, sub};
+use super::ContactModel;
 
 /// The shape of a rigid surface.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -176,6 +182,50 @@ impl RigidSurface {
                 } else {
                     None
                 }
+            }
+        }
+    }
+}
+
+impl ContactModel {
+    /// The contacts of surface node `k` with the rigid surfaces (in their order), with
+    /// friction and the power the moving surface puts into the body, appended to `out`;
+    /// node velocities `v` (m/s), time `t` (s), step `dt` (s).
+    pub(super) fn rigid_hits(&self, k: usize, v: &[[f64; 3]], t: f64, dt: f64, out: &mut Vec<Hit>) {
+        let i = self.surface.nodes[k];
+        let nr = self.rigid.len();
+        for (r, s) in self.rigid.iter().enumerate() {
+            let hn = self.surface.node_half_thickness[k];
+            if let Some((d, n, vs)) = s.probe_offset(self.x[i], t, hn) {
+                let kn = self.surface.node_stiffness[k];
+                let vrel = sub(v[i], vs);
+                let h = friction_update(
+                    self.stick_rigid[k * nr + r],
+                    n,
+                    vrel,
+                    vs,
+                    d,
+                    kn,
+                    s.friction,
+                    dt,
+                );
+                // Power the moving surface puts into the body: F·v_s.
+                let work = dot(add(h.0, h.1), vs) * dt;
+                out.push(Hit {
+                    slave: k as u32,
+                    partner: r as u32,
+                    rigid: true,
+                    weights: [0.0; 3],
+                    normal_force: h.0,
+                    tangential_force: h.1,
+                    stiffness: kn,
+                    penetration: d,
+                    offset: 0.0,
+                    side: 1.0,
+                    elastic: h.2,
+                    dissipated: h.3,
+                    rigid_work: work,
+                });
             }
         }
     }

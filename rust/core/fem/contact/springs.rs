@@ -4,7 +4,8 @@
 
 use crate::error::{check_positive, DemfemError, Result};
 
-use super::vec3::{norm, scale, sub};
+use super::vec3::{add, norm, scale, sub};
+use super::ContactModel;
 
 /// One no-tension spring.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -52,5 +53,22 @@ impl NoTensionSpring {
             scale(r, self.stiffness * c / l),
             0.5 * self.stiffness * c * c,
         )
+    }
+}
+
+impl ContactModel {
+    /// Add the forces of the no-tension springs into `force` (N per node), and, when
+    /// `check`, their stiffness into the Gershgorin bounds; returns their stored energy, J.
+    pub(super) fn spring_forces(&mut self, force: &mut [[f64; 3]], check: bool) -> f64 {
+        let mut spring_energy = 0.0;
+        for s in &self.springs {
+            let (f, e) = s.force(self.x[s.node]);
+            force[s.node] = add(force[s.node], f);
+            spring_energy += e;
+            if check && e > 0.0 {
+                self.gershgorin[s.node] += s.stiffness / self.mass[s.node];
+            }
+        }
+        spring_energy
     }
 }
