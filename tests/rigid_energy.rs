@@ -17,16 +17,22 @@ fn total_kinetic(scene: &RigidScene) -> f64 {
 /// off centre, so both spin after the hit) without gravity, damping or friction. Returns
 /// (E_after / E_before − 1, largest E_kinetic / E_before − 1 during the impact, contact
 /// evaluations).
-fn tilted_collision(tilt_a: f64, tilt_b: f64, speed: f64, spin: f64) -> (f64, f64, u64, f64) {
+fn tilted_collision(
+    kind: &str,
+    tilt_a: f64,
+    tilt_b: f64,
+    speed: f64,
+    spin: f64,
+) -> (f64, f64, u64, f64) {
     let config = RigidSceneConfig {
         gravity: Vector3::zeros(),
         restitution: 1.0,
         friction: 0.0,
         ..Default::default()
     };
-    let (shape, mass) = cartridge("exact");
+    let (shape, mass) = cartridge(kind);
     // a quarter of the 5 m/s limit: the Verlet error of one impact (∝ Δt²) stays < 1e-4
-    let dt = 0.25 * time_step_limit_of(config.clone(), "exact");
+    let dt = 0.25 * time_step_limit_of(config.clone(), kind);
     let mut scene = RigidScene::new(RigidSceneConfig {
         time_step: Some(dt),
         ..config
@@ -45,7 +51,7 @@ fn tilted_collision(tilt_a: f64, tilt_b: f64, speed: f64, spin: f64) -> (f64, f6
             ..Default::default()
         })
         .unwrap();
-        let (s, m) = cartridge("exact");
+        let (s, m) = cartridge(kind);
         let pid = probe.add_shape(s, m).unwrap();
         for (x, q) in [
             (Vector3::zeros(), qa),
@@ -109,8 +115,7 @@ fn tilted_collision(tilt_a: f64, tilt_b: f64, speed: f64, spin: f64) -> (f64, f6
     )
 }
 
-#[test]
-fn tilted_exact_cartridges_collide_without_gaining_energy() {
+fn tilted_collisions(kind: &str) {
     // before the fix (frozen parry manifolds, skew clip points at full overlap) the spin
     // changed by up to 0.15 rad/s and the energy by up to 2e-4
     for (tilt_a, tilt_b, speed, spin) in [
@@ -121,9 +126,9 @@ fn tilted_exact_cartridges_collide_without_gaining_energy() {
         (30.0, 25.0, 0.1, 500.0),
     ] {
         let (change, peak, evaluations, spin_change) =
-            tilted_collision(tilt_a, tilt_b, speed, spin);
+            tilted_collision(kind, tilt_a, tilt_b, speed, spin);
         println!(
-            "tilts {tilt_a}° / {tilt_b}° at {speed} m/s, spin {spin} rad/s: E1/E0 − 1 = {change:e}, peak KE/E0 − 1 = {peak:e}, {evaluations} steps in contact, axial spin change {spin_change:e} rad/s"
+            "{kind}: tilts {tilt_a}° / {tilt_b}° at {speed} m/s, spin {spin} rad/s: E1/E0 − 1 = {change:e}, peak KE/E0 − 1 = {peak:e}, {evaluations} steps in contact, axial spin change {spin_change:e} rad/s"
         );
         assert!(change.abs() < 1e-5, "E1/E0 − 1 = {change:e}");
         assert!(
@@ -137,6 +142,16 @@ fn tilted_exact_cartridges_collide_without_gaining_energy() {
             "axial spin changed by {spin_change:e} rad/s"
         );
     }
+}
+
+#[test]
+fn tilted_exact_cartridges_collide_without_gaining_energy() {
+    tilted_collisions("exact");
+}
+
+#[test]
+fn tilted_revolution_cartridges_collide_without_gaining_energy() {
+    tilted_collisions("revolution");
 }
 
 /// A small deterministic generator (64-bit LCG), uniform in [0, 1).
@@ -155,7 +170,12 @@ impl Lcg {
 /// `n` exact cartridges at random orientations dropped into a 14.4 cm square box on the belt
 /// (E = 450 MPa as the equivalence study, e = 0.5, μ = 0.3), for `seconds` s. Returns the
 /// samples of (time s, kinetic + gravitational energy J, largest speed m/s) every 20 steps.
-fn settle_pile(n: usize, seconds: f64, seed: u64) -> (Vec<(f64, f64, f64)>, RigidScene) {
+fn settle_pile(
+    kind: &str,
+    n: usize,
+    seconds: f64,
+    seed: u64,
+) -> (Vec<(f64, f64, f64)>, RigidScene) {
     let half = 0.072;
     let mut planes = vec![RigidSceneConfig::belt(Vector3::zeros()).unwrap()];
     for (point, normal) in [
@@ -179,7 +199,7 @@ fn settle_pile(n: usize, seconds: f64, seed: u64) -> (Vec<(f64, f64, f64)>, Rigi
         max_expected_speed: 2.0,
         ..Default::default()
     };
-    let (shape, mass) = cartridge("exact");
+    let (shape, mass) = cartridge(kind);
     let mut scene = RigidScene::new(config).unwrap();
     let id = scene.add_shape(shape, mass).unwrap();
     let mut rng = Lcg(seed);
@@ -227,7 +247,16 @@ fn settle_pile(n: usize, seconds: f64, seed: u64) -> (Vec<(f64, f64, f64)>, Rigi
 
 #[test]
 fn damped_pile_of_exact_cartridges_never_gains_energy() {
-    let (samples, scene) = settle_pile(12, 0.5, 7);
+    damped_pile("exact");
+}
+
+#[test]
+fn damped_pile_of_revolution_cartridges_never_gains_energy() {
+    damped_pile("revolution");
+}
+
+fn damped_pile(kind: &str) {
+    let (samples, scene) = settle_pile(kind, 12, 0.5, 7);
     let e0 = samples[0].1;
     let mut lowest = f64::INFINITY;
     let mut worst_rise: f64 = 0.0;
@@ -239,7 +268,7 @@ fn damped_pile_of_exact_cartridges_never_gains_energy() {
     }
     let last = samples[samples.len() - 1];
     println!(
-        "pile: E0 {e0:e} J, final {:e} J, worst rise above the running minimum {worst_rise:e} J, max speed {vmax} m/s, final max speed {} m/s, {} contact points",
+        "{kind} pile: E0 {e0:e} J, final {:e} J, worst rise above the running minimum {worst_rise:e} J, max speed {vmax} m/s, final max speed {} m/s, {} contact points",
         last.1,
         last.2,
         scene.contacts_last_step()
@@ -276,7 +305,7 @@ fn total_energy(scene: &RigidScene, g: f64) -> f64 {
 /// No damping, no friction: B rocks on A and the floor. Returns the largest |E(t) − E(0)|
 /// relative to the energy that can turn into motion (E(0) less both lying at rest), and the
 /// time in contact.
-fn crossed_rocking(yaw: f64, pitch: f64, seconds: f64) -> (f64, f64) {
+fn crossed_rocking(kind: &str, yaw: f64, pitch: f64, seconds: f64) -> (f64, f64) {
     let glass = demfem::rigid::ContactMaterial {
         young_modulus: 45e7,
         poisson_ratio: 0.22,
@@ -290,7 +319,7 @@ fn crossed_rocking(yaw: f64, pitch: f64, seconds: f64) -> (f64, f64) {
         max_expected_speed: 1.0,
         ..Default::default()
     };
-    let (shape, mass) = cartridge("exact");
+    let (shape, mass) = cartridge(kind);
     let mut scene = RigidScene::new(config).unwrap();
     let id = scene.add_shape(shape, mass).unwrap();
     let r = 5.8e-3;
@@ -354,9 +383,18 @@ fn crossed_rocking(yaw: f64, pitch: f64, seconds: f64) -> (f64, f64) {
 
 #[test]
 fn crossed_exact_cartridges_rocking_without_damping_keep_their_energy() {
+    crossed("exact");
+}
+
+#[test]
+fn crossed_revolution_cartridges_rocking_without_damping_keep_their_energy() {
+    crossed("revolution");
+}
+
+fn crossed(kind: &str) {
     for (yaw, pitch) in [(30.0, 20.0), (60.0, 35.0)] {
-        let (error, in_contact) = crossed_rocking(yaw, pitch, 0.3);
-        println!("yaw {yaw}° pitch {pitch}°: max |ΔE|/E_free = {error:e}, {in_contact:e} s body–body contact");
+        let (error, in_contact) = crossed_rocking(kind, yaw, pitch, 0.3);
+        println!("{kind}: yaw {yaw}° pitch {pitch}°: max |ΔE|/E_free = {error:e}, {in_contact:e} s body–body contact");
         assert!(in_contact > 1e-3, "B barely touched A ({in_contact} s)");
         assert!(
             error < 1e-3,

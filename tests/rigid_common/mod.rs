@@ -1,11 +1,12 @@
 //! Shared fixtures of the rigid-body tests and benches: the default cartridge as a clump of
-//! 632 beads (from `Cartridge().bead_clump(632)`, see tests/data/make_cartridge_clump.py) and
-//! as an exact parry shape, both with their mass properties.
+//! 632 beads (from `Cartridge().bead_clump(632)`, see tests/data/make_cartridge_clump.py), as
+//! an exact parry shape and as the analytic body of revolution, all with their mass
+//! properties.
 #![allow(dead_code)]
 
 use demfem::rigid::{
-    BeadClump, ExactShape, MassProperties, RevolutionProfile, RigidScene, RigidSceneConfig,
-    RigidShape,
+    BeadClump, ExactShape, MassProperties, RevolutionProfile, RevolutionShape, RigidScene,
+    RigidSceneConfig, RigidShape,
 };
 use nalgebra::{UnitQuaternion, Vector3};
 
@@ -42,12 +43,24 @@ pub fn cartridge_exact() -> (ExactShape, MassProperties) {
     (shape, mass)
 }
 
-/// Either representation, as a scene shape.
+/// The default cartridge as the analytic body of revolution with its exact mass properties.
+pub fn cartridge_revolution() -> (RevolutionShape, MassProperties) {
+    let profile = RevolutionProfile::default_cartridge();
+    let mass = profile.mass_properties(GLASS_DENSITY).unwrap();
+    let shape = RevolutionShape::from_profile(&profile, mass.center_of_mass.z).unwrap();
+    (shape, mass)
+}
+
+/// Any representation ("clump", "revolution", else the exact parry shape), as a scene shape.
 pub fn cartridge(kind: &str) -> (RigidShape, MassProperties) {
     match kind {
         "clump" => {
             let (c, m) = cartridge_clump();
             (RigidShape::Clump(c), m)
+        }
+        "revolution" => {
+            let (r, m) = cartridge_revolution();
+            (RigidShape::Revolution(r), m)
         }
         _ => {
             let (e, m) = cartridge_exact();

@@ -4,6 +4,8 @@
 //!
 //! - [`body`]: state (structure of arrays) and the symplectic rigid-body integrator;
 //! - [`shape`]: the body of revolution, the bead clump and the exact parry compound;
+//! - [`revolution`]: the fast exact cartridge, a body of revolution of coaxial frustums with
+//!   analytic contact tests (bodies, planes, polygon walls, beads);
 //! - [`collision`]: contact points between shapes, planes and spheres (pure geometry);
 //! - [`forces`]: Hertz + Tsuji normal force and Mindlin–Coulomb friction per contact;
 //! - [`scene`]: gravity, belt, walls, time-step limit and the step loop.
@@ -15,6 +17,7 @@
 pub mod body;
 pub mod collision;
 pub mod forces;
+pub mod revolution;
 pub mod scene;
 pub mod shape;
 
@@ -22,6 +25,7 @@ pub use body::{RigidBodies, RigidBodyInit};
 pub use collision::{BodyPose, ContactPoint, Plane, PolygonWall};
 pub use forces::{ContactMaterial, ContactModel};
 pub use scene::{RigidOnset, RigidScene, RigidSceneConfig, RigidWall};
+pub use revolution::RevolutionShape;
 pub use shape::{
     BeadClump, BoundingCapsule, ExactShape, MassProperties, RevolutionProfile, RigidShape,
 };

@@ -39,6 +39,7 @@ use crate::error::{check_positive, DemfemError, Result};
 use crate::geometry::{MeshWall, WallMotion, WallShape};
 
 mod contacts;
+mod revolution_pass;
 
 use contacts::FrictionHistory;
 
@@ -236,6 +237,8 @@ pub struct RigidScene {
     touching_next: HashSet<u64>,
     coordination: Vec<u32>,
     wall_contacts: Vec<u32>,
+    /// The contact pass of scenes with bodies of revolution (`None` without them).
+    revolution: Option<revolution_pass::RevolutionPass>,
 }
 
 impl RigidScene {
@@ -309,6 +312,7 @@ impl RigidScene {
             touching_next: HashSet::new(),
             coordination: Vec::new(),
             wall_contacts: Vec::new(),
+            revolution: None,
         })
     }
 
@@ -318,6 +322,24 @@ impl RigidScene {
         check_positive("mass", mass.mass)?;
         for k in 0..3 {
             check_positive("principal_inertia", mass.principal_inertia[k])?;
+        }
+        let revolution = matches!(shape, RigidShape::Revolution(_));
+        let exact = |s: &RigidShape| matches!(s, RigidShape::Exact(_));
+        let mixed = if revolution {
+            self.shapes.iter().any(|(s, _)| exact(s))
+        } else {
+            exact(&shape) && self.revolution.is_some()
+        };
+        if mixed {
+            return Err(DemfemError::ShapeMismatch {
+                field: "shape".into(),
+                detail: "bodies of revolution share a scene with bead clumps and spheres, not \
+                         with parry exact shapes"
+                    .into(),
+            });
+        }
+        if revolution && self.revolution.is_none() {
+            self.revolution = Some(revolution_pass::RevolutionPass::default());
         }
         self.shapes.push((shape, mass));
         Ok(self.shapes.len() - 1)
@@ -469,6 +491,12 @@ impl RigidScene {
     /// Planes and walls each body touched in the last force evaluation.
     pub fn wall_contacts(&self) -> &[u32] {
         &self.wall_contacts
+    }
+
+    /// Rebuilds of the candidate-pair list of the revolution pass (0 without bodies of
+    /// revolution).
+    pub fn pair_list_rebuilds(&self) -> u64 {
+        self.revolution.as_ref().map_or(0, |p| p.rebuilds())
     }
 
     /// Shape of body `i`.

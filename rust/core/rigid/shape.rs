@@ -1,5 +1,6 @@
 //! Shapes of a rigid cartridge: the body of revolution it is derived from, a clump of beads,
-//! and an exact shape made of parry3d-f64 convex pieces.
+//! an exact shape made of parry3d-f64 convex pieces, and the fast exact body of revolution
+//! of [`super::revolution`].
 //!
 //! Every shape lives in the body frame: origin at the centre of mass, principal axes along
 //! the frame axes, the cartridge axis along body z. The geometry itself comes from one place,
@@ -10,6 +11,7 @@ use nalgebra::{Matrix3, SymmetricEigen, UnitQuaternion, Vector3};
 use parry3d_f64::math::{Pose, Rotation, Vector};
 use parry3d_f64::shape::{Compound, ConvexPolyhedron, Cylinder, SharedShape};
 
+use super::revolution::RevolutionShape;
 use crate::error::{check_non_negative, check_positive, DemfemError, Result};
 
 /// Mass (kg), centre of mass (m) and principal inertia (kg·m²) of a body.
@@ -473,6 +475,9 @@ pub enum RigidShape {
     Clump(BeadClump),
     /// An exact shape through parry3d-f64.
     Exact(ExactShape),
+    /// The fast exact body of revolution with analytic contact tests
+    /// ([`super::revolution`]).
+    Revolution(RevolutionShape),
 }
 
 impl RigidShape {
@@ -481,6 +486,7 @@ impl RigidShape {
         match self {
             RigidShape::Clump(c) => c.bounding_radius,
             RigidShape::Exact(e) => e.bounding_radius,
+            RigidShape::Revolution(r) => r.bounding_radius,
         }
     }
 
@@ -489,6 +495,7 @@ impl RigidShape {
         match self {
             RigidShape::Clump(c) => c.bounding_capsule,
             RigidShape::Exact(e) => e.bounding_capsule,
+            RigidShape::Revolution(r) => r.bounding_capsule,
         }
     }
 
@@ -501,6 +508,7 @@ impl RigidShape {
                 .iter()
                 .cloned()
                 .fold(f64::INFINITY, f64::min),
+            RigidShape::Revolution(r) => r.min_contact_radius,
         }
     }
 
@@ -509,6 +517,7 @@ impl RigidShape {
         match self {
             RigidShape::Clump(c) => &c.centers,
             RigidShape::Exact(e) => &e.rim_points,
+            RigidShape::Revolution(r) => &r.rim_points,
         }
     }
 }

@@ -70,6 +70,19 @@ impl PolygonWall {
         })
     }
 
+    /// The polygon at its reference position: vertices (m, boundary order), unit normal and
+    /// inward in-plane edge normals.
+    pub fn parts(&self) -> (&[crate::geometry::Vec3], crate::geometry::Vec3, &[crate::geometry::Vec3]) {
+        match &self.shape {
+            WallShape::Polygon {
+                vertices,
+                normal,
+                edge_normals,
+            } => (vertices, *normal, edge_normals),
+            _ => (&[], crate::geometry::Vec3::ZERO, &[]),
+        }
+    }
+
     /// Closest point (m), unit normal from the wall towards `p` and distance (m) of the
     /// world point `p` from the wall displaced by `offset` (m).
     fn closest(

@@ -77,7 +77,12 @@ impl Hasher for ContactKeyHasher {
 pub(super) type FrictionHistory =
     HashMap<ContactKey, Vector3<f64>, BuildHasherDefault<ContactKeyHasher>>;
 
-fn plane_object(plane: usize) -> u64 {
+/// Scenes with bodies of revolution run their own contact pass (`revolution_pass`).
+fn revolution_elsewhere() -> DemfemError {
+    DemfemError::Effect("bodies of revolution are handled by the revolution pass".into())
+}
+
+pub(super) fn plane_object(plane: usize) -> u64 {
     (u32::MAX as u64) - plane as u64
 }
 
@@ -122,6 +127,9 @@ impl RigidScene {
 
     /// Gravity and every contact force and torque of the configuration at time `time` (s).
     pub(super) fn compute_forces(&mut self, time: f64) -> Result<()> {
+        if self.revolution.is_some() {
+            return self.compute_forces_revolution(time);
+        }
         self.bodies.clear_forces();
         self.evaluations += 1;
         let evaluation = self.evaluations;
@@ -176,6 +184,7 @@ impl RigidScene {
                             cache.last_used = evaluation;
                             exact_plane_contacts(&plane, shape, &pose, cache, &mut contacts)?
                         }
+                        RigidShape::Revolution(_) => return Err(revolution_elsewhere()),
                     }
                     plane.surface_velocity
                 } else {
@@ -204,8 +213,10 @@ impl RigidScene {
                                         &mut contacts,
                                     )?
                                 }
+                                RigidShape::Revolution(_) => return Err(revolution_elsewhere()),
                             }
                         }
+                        (_, RigidShape::Revolution(_)) => return Err(revolution_elsewhere()),
                         (PreparedShape::Mesh(mesh), RigidShape::Clump(clump)) => {
                             clump_mesh_contacts(mesh, &offset, clump, &pose, &mut contacts)
                         }
@@ -344,6 +355,9 @@ impl RigidScene {
                         flipped = true;
                         clump_exact_contacts(cb, &pb, ea, &pa, &mut contacts)?
                     }
+                    (RigidShape::Revolution(_), _) | (_, RigidShape::Revolution(_)) => {
+                        return Err(revolution_elsewhere())
+                    }
                 }
                 if contacts.is_empty() {
                     continue;
@@ -470,7 +484,7 @@ fn distinct_piece_pairs(contacts: &[ContactPoint]) -> usize {
 
 /// True when the bounding capsules of two bodies overlap (a cheap, tight cull for long
 /// bodies: two upright cartridges 2 cm apart have overlapping bounding spheres, not capsules).
-fn capsules_overlap(
+pub(super) fn capsules_overlap(
     a: &BoundingCapsule,
     pose_a: &BodyPose,
     b: &BoundingCapsule,
