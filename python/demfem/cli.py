@@ -278,7 +278,7 @@ def _cmd_assess(args: argparse.Namespace) -> int:
         flaw = None
     elif flaw != "characteristic":
         try:
-            flaw = float(flaw)
+            flaw = float(str(args.flaw_depth))
         except ValueError:
             raise InvalidParameterError(f"invalid --flaw-depth {args.flaw_depth!r}: must be "
                                         "characteristic, none or a depth in m") from None

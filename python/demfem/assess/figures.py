@@ -111,7 +111,7 @@ def make_figures(out: Path, data: dict[str, Any]) -> dict[str, bytes]:
     if counts.sum():
         ax.stairs(counts, bins, fill=True, color="0.7", label="impact onsets (not the belt)")
         if len(ev):
-            ax.hist(ev["normal_speed"], bins=bins, color="C3", alpha=0.7,
+            ax.hist(ev["normal_speed"], bins=list(bins), color="C3", alpha=0.7,
                     label="events (pressed ones at their slow onset)")
     ax.axvline(data["min_speed"], color="k", ls="--", lw=1)
     ax.set_xscale("log")

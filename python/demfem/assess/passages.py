@@ -81,8 +81,8 @@ def passages(n: int, removal_times: Any, removal_index: Any, insertion_times: An
                     f"invalid insertion log: sphere {i} is put back at t = {t:g} s while on the "
                     "table")
             on[i], start[i] = True, t
-    for i in np.flatnonzero(on):
-        rows.append((int(i), float(start[i]), math.nan, False))
+    for on_table in np.flatnonzero(on):
+        rows.append((int(on_table), float(start[on_table]), math.nan, False))
     out = np.array(rows, PASSAGE_DTYPE) if rows else np.zeros(0, PASSAGE_DTYPE)
     out = out[np.lexsort((out["start"], out["particle"]))]
     if math.isfinite(end_time):

@@ -74,7 +74,7 @@ import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Mapping, Optional
+from typing import Any, Mapping
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -172,8 +172,9 @@ class AccumulationTable:
     """
 
     n_spheres: int = 840
-    sphere_radius: Optional[float] = None
-    sphere_mass: Optional[float] = None
+    # None: derived from the cartridge in __post_init__ (always a float afterwards)
+    sphere_radius: float = None  # type: ignore[assignment]
+    sphere_mass: float = None  # type: ignore[assignment]
     length: float = 0.70
     width: float = 0.34
     tilted_wall_length: float = 0.36

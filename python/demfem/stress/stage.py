@@ -159,7 +159,7 @@ def collision_stresses(normal_speed: np.ndarray, partner: np.ndarray, young_modu
         friction = mu_cap if mu_cap > 0 else None
     out["tangential_force_N"] = q
     if isinstance(model, StressModel) or model == "shell":
-        m = StressModel.default() if model == "shell" else model
+        m = model if isinstance(model, StressModel) else StressModel.default()
         out["sigma_inner_Pa"] = m.sigma_inner(f)
         out["sigma_outer_Pa"] = m.sigma_outer(f)
         out["area_inner_m2"], out["area_outer_m2"] = m.stressed_areas(
