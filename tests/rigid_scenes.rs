@@ -75,6 +75,11 @@ fn exact_cartridge_dropped_upright_comes_to_rest_upright() {
     drop_upright_and_settle("exact");
 }
 
+#[test]
+fn revolution_cartridge_dropped_upright_comes_to_rest_upright() {
+    drop_upright_and_settle("revolution");
+}
+
 /// Two cartridges collide end to end along their common axis (bottom against bottom), no
 /// gravity, no belt; returns (momentum error / m v, E1/E0, realised restitution).
 fn head_on(kind: &str, restitution: f64) -> (f64, f64, f64) {
@@ -154,7 +159,7 @@ fn head_on_pair(kind: &str, other_kind: &str, restitution: f64) -> (f64, f64, f6
 
 #[test]
 fn elastic_head_on_collision_conserves_momentum_and_energy() {
-    for kind in ["clump", "exact"] {
+    for kind in ["clump", "exact", "revolution"] {
         let (p_error, energy_ratio, restitution) = head_on(kind, 1.0);
         println!(
             "{kind} elastic: momentum error {p_error:e}, E1/E0 - 1 = {:e}, e = {restitution}",
@@ -170,7 +175,7 @@ fn elastic_head_on_collision_conserves_momentum_and_energy() {
 
 #[test]
 fn damped_head_on_collision_conserves_momentum_and_loses_energy() {
-    for kind in ["clump", "exact"] {
+    for kind in ["clump", "exact", "revolution"] {
         let (p_error, energy_ratio, restitution) = head_on(kind, 0.5);
         println!("{kind} e=0.5: momentum error {p_error:e}, E1/E0 = {energy_ratio}, realised e = {restitution}");
         assert!(p_error < 1e-13, "{kind}: momentum error {p_error:e}");
@@ -188,6 +193,16 @@ fn damped_head_on_collision_conserves_momentum_and_loses_energy() {
 }
 
 #[test]
+fn clump_against_revolution_shape_conserves_momentum() {
+    // the mixed pair goes through the beads' meridian distances with the clump first
+    let (p_error, energy_ratio, restitution) = head_on_pair("clump", "revolution", 0.5);
+    println!("clump on revolution e=0.5: momentum error {p_error:e}, E1/E0 = {energy_ratio}, e = {restitution}");
+    assert!(p_error < 1e-13);
+    assert!((restitution - 0.5).abs() < 0.1, "{restitution}");
+    assert!(energy_ratio < 1.0);
+}
+
+#[test]
 fn clump_against_exact_shape_conserves_momentum() {
     // the mixed pair goes through parry ball–compound queries with the clump first
     let (p_error, energy_ratio, restitution) = head_on_pair("clump", "exact", 0.5);
@@ -201,7 +216,7 @@ fn clump_against_exact_shape_conserves_momentum() {
 
 #[test]
 fn no_cartridge_passes_through_a_wall_at_5_m_per_s() {
-    for kind in ["clump", "exact"] {
+    for kind in ["clump", "exact", "revolution"] {
         let wall = Plane::new(
             Vector3::new(0.02, 0.0, 0.0),
             -Vector3::x(),
@@ -285,7 +300,7 @@ fn tilted_cartridge_falls_over_when_its_centre_of_mass_is_outside_the_base() {
     // critical tilt: atan(r_out / z_com) = atan(5.8 / 30.7) ≈ 10.7°
     let critical = (5.8e-3 / com_height()).atan().to_degrees();
     assert!((critical - 10.7).abs() < 0.1);
-    for kind in ["clump", "exact"] {
+    for kind in ["clump", "exact", "revolution"] {
         let (fallen, _) = release_tilted(kind, 20.0, 0.4);
         let (rocking, largest) = release_tilted(kind, 5.0, 0.4);
         println!("{kind}: from 20° → {fallen:.2}°; from 5° → {rocking:.2}°, largest {largest:.3}°");
@@ -340,7 +355,7 @@ fn on_moving_belt(kind: &str, friction: f64, seconds: f64) -> (f64, f64, f64) {
 fn belt_friction_accelerates_at_mu_g_and_tips_only_above_r_over_h() {
     // sliding on its base the cartridge accelerates at μ g until it moves with the belt; the
     // friction at the base tips it over when μ g exceeds g r/h (r/h = 5.8/30.7 = 0.19)
-    for kind in ["clump", "exact"] {
+    for kind in ["clump", "exact", "revolution"] {
         let mu = 0.1;
         let (early, late, largest) = on_moving_belt(kind, mu, 0.3);
         println!("{kind} μ = {mu}: v(0.05 s) = {early:.4} m/s, v(0.3 s) = {late:.4} m/s, tilt ≤ {largest:.3}°");
@@ -382,7 +397,7 @@ fn lying_on_slope(kind: &str, slope: f64, seconds: f64) -> f64 {
 
 #[test]
 fn static_friction_holds_below_atan_mu_and_slides_at_the_coulomb_rate_above() {
-    for kind in ["clump", "exact"] {
+    for kind in ["clump", "exact", "revolution"] {
         // tan 10° = 0.18 < μ: the Mindlin springs hold it (no creep)
         let held = lying_on_slope(kind, 10.0, 0.1);
         // tan 25° = 0.47 > μ: it slides with a = g (sin α − μ cos α)

@@ -125,6 +125,11 @@ fn exact_cartridge_rests_against_either_face_of_a_vertical_polygon() {
     rest_against_polygon("exact");
 }
 
+#[test]
+fn revolution_cartridge_rests_against_either_face_of_a_vertical_polygon() {
+    rest_against_polygon("revolution");
+}
+
 /// A gate polygon oscillating as x = A sin(ωt) hits a cartridge lying along x, bottom end
 /// first, `gap` ahead of it (no gravity, no friction, restitution 1). Against an infinitely
 /// heavy wall moving at V the elastic rebound leaves the body at 2V, V = Aω cos(ω t_hit)
@@ -195,6 +200,11 @@ fn exact_cartridge_pushed_by_a_moving_gate_leaves_at_twice_the_gate_speed() {
     pushed_by_gate("exact");
 }
 
+#[test]
+fn revolution_cartridge_pushed_by_a_moving_gate_leaves_at_twice_the_gate_speed() {
+    pushed_by_gate("revolution");
+}
+
 /// A cartridge crossing the outlet plane is removed at the step its centre crosses it and
 /// stays where it was.
 #[test]
@@ -245,6 +255,15 @@ fn cuboid_walls_are_refused() {
 /// frictionless, it hits at √(2 g h) both times.
 #[test]
 fn exact_cartridge_bouncing_off_a_wall_twice() {
+    bouncing_twice("exact");
+}
+
+#[test]
+fn revolution_cartridge_bouncing_off_a_wall_twice() {
+    bouncing_twice("revolution");
+}
+
+fn bouncing_twice(kind: &str) {
     let g = 9.81;
     let config = RigidSceneConfig {
         gravity: Vector3::new(0.0, 0.0, -g),
@@ -259,7 +278,7 @@ fn exact_cartridge_bouncing_off_a_wall_twice() {
         record_onsets: true,
         ..Default::default()
     };
-    let (mut scene, id) = scene("exact", config);
+    let (mut scene, id) = scene(kind, config);
     let z0 = 0.04; // the bottom 9 mm above the floor: out of the bounding sphere's reach
     scene
         .add_body(
@@ -291,6 +310,17 @@ fn exact_cartridge_bouncing_off_a_wall_twice() {
 /// once where a bead sits over a shared edge or vertex of the mesh) to 1e-9 m.
 #[test]
 fn clump_rests_against_a_mesh_wall_as_against_the_polygon() {
+    rests_against_mesh("clump");
+}
+
+/// The same with the body of revolution: the mesh's shared edges and vertices (flat) give no
+/// contact of their own.
+#[test]
+fn revolution_cartridge_rests_against_a_mesh_wall_as_against_the_polygon() {
+    rests_against_mesh("revolution");
+}
+
+fn rests_against_mesh(kind: &str) {
     use demfem::geometry::MeshWall;
     let n = 10;
     let half = 0.05;
@@ -322,7 +352,7 @@ fn clump_rests_against_a_mesh_wall_as_against_the_polygon() {
             max_expected_speed: 1.0,
             ..Default::default()
         };
-        let (mut scene, id) = scene("clump", config);
+        let (mut scene, id) = scene(kind, config);
         scene
             .add_body(
                 id,
@@ -341,7 +371,7 @@ fn clump_rests_against_a_mesh_wall_as_against_the_polygon() {
     println!("mesh {x_m:?} {v_m:?}\npolygon {x_p:?} {v_p:?}");
     assert!((x_m - x_p).norm() < 1e-9, "{x_m:?} vs {x_p:?}");
     assert!((v_m - v_p).norm() < 1e-7, "{v_m:?} vs {v_p:?}");
-    assert!(x_m.x < R_OUT && x_m.x > side_envelope_min("clump") - 2e-6);
+    assert!(x_m.x < R_OUT && x_m.x > side_envelope_min(kind) - 2e-6);
 }
 
 /// A rotating wall is refused by the rigid scene (not implemented there), naming the wall.

@@ -270,6 +270,11 @@ impl MeshWall {
         &self.edges
     }
 
+    /// The edges of triangle `t`: edge k joins its corners k and (k + 1) % 3.
+    pub fn triangle_edges(&self, t: u32) -> [u32; 3] {
+        self.triangle_edges[t as usize]
+    }
+
     /// The triangles holding edge `e`.
     pub fn edge_triangles(&self, e: u32) -> &[u32] {
         let e = e as usize;

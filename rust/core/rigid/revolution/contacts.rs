@@ -258,16 +258,34 @@ pub fn pair_contacts(
         if weight <= 0.0 {
             continue;
         }
-        out.push(ContactPoint {
-            point: 0.5 * (f.point_a + f.point_b),
-            normal: f.normal,
-            overlap: -f.distance,
-            radius_first: feature_radius(a, f.feature_a, &f.point_a, &f.normal),
-            radius_second: feature_radius(b, f.feature_b, &f.point_b, &(-f.normal)),
-            feature_first: f.feature_a.key(),
-            feature_second: f.feature_b.key(),
-        });
-        weights.push(weight);
+        match (f.feature_a, f.feature_b) {
+            (Feature::Face(face), Feature::Edge(edge)) => {
+                face_points(a, face, scratch.found[k].1, b, edge, out);
+                weights.resize(out.len(), weight);
+            }
+            (Feature::Edge(edge), Feature::Face(face)) => {
+                let start = out.len();
+                face_points(b, face, scratch.found[k].2, a, edge, out);
+                for c in &mut out[start..] {
+                    c.normal = -c.normal;
+                    std::mem::swap(&mut c.radius_first, &mut c.radius_second);
+                    std::mem::swap(&mut c.feature_first, &mut c.feature_second);
+                }
+                weights.resize(out.len(), weight);
+            }
+            _ => {
+                out.push(ContactPoint {
+                    point: 0.5 * (f.point_a + f.point_b),
+                    normal: f.normal,
+                    overlap: -f.distance,
+                    radius_first: feature_radius(a, f.feature_a, &f.point_a, &f.normal),
+                    radius_second: feature_radius(b, f.feature_b, &f.point_b, &(-f.normal)),
+                    feature_first: f.feature_a.key(),
+                    feature_second: f.feature_b.key(),
+                });
+                weights.push(weight);
+            }
+        }
     }
     for &(i, j, gh, lo, hi, sigma) in &scratch.lines {
         let (rod_a, rod_b) = (piece_rod(a, i), piece_rod(b, j));
@@ -285,6 +303,52 @@ pub fn pair_contacts(
                 weights.push(sample.weight);
             }
         }
+    }
+}
+
+/// Flat face `face` of X (on its piece `piece`) against edge circle `edge` of Y: four points
+/// of the circle at quarter turns anchored at its deepest point along the face normal, as on
+/// a plane (so that two cartridges end to end press rim on rim evenly), each kept where it
+/// overlaps the face, projects onto it and lies in X's piece; appended oriented X → Y.
+fn face_points(x: &Placed, face: usize, piece: usize, y: &Placed, edge: usize, out: &mut Vec<ContactPoint>) {
+    let f = x.shape.faces[face];
+    let circle = y.shape.circles[edge];
+    let m = x.axis * f.facing;
+    let face_centre = x.at(f.z);
+    let in_plane = m - y.axis * m.dot(&y.axis);
+    let s = in_plane.norm();
+    let (u, v) = if s > 1e-14 {
+        let u = -in_plane / s;
+        (u, y.axis.cross(&u))
+    } else {
+        (y.x, y.y)
+    };
+    let centre = y.at(circle.z);
+    let tolerance = 1e-6 * f.r[1];
+    let radius_y = circle.contact_radius(-m.dot(&y.axis), s);
+    let quarter = [(1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0)];
+    for (j, (c, sn)) in quarter.into_iter().enumerate() {
+        let p = centre + (u * c + v * sn) * circle.r;
+        let overlap = -m.dot(&(p - face_centre));
+        if overlap <= 0.0 {
+            continue;
+        }
+        let (_, _, rho) = x.meridian(&p);
+        if rho < f.r[0] - tolerance || rho > f.r[1] + tolerance {
+            continue;
+        }
+        if !super::features::inside_piece(x, piece, &p) {
+            continue;
+        }
+        out.push(ContactPoint {
+            point: p + m * (0.5 * overlap),
+            normal: m,
+            overlap,
+            radius_first: f.contact_radius,
+            radius_second: radius_y,
+            feature_first: Feature::Face(face).key(),
+            feature_second: Feature::Edge(edge).key() + ((j as u64) << 12),
+        });
     }
 }
 

@@ -17,10 +17,12 @@
 //! Submodules: [`features`] finds the closest features of two pieces exactly (Lin–Canny
 //! style: every pair of features whose closest points satisfy the normal-cone conditions),
 //! [`contacts`] turns them into the contact points of the force law (bodies, planes, polygon
-//! walls, beads), [`wall_edges`] handles the edges and corners of polygon walls.
+//! walls, beads), [`wall_edges`] handles the edges and corners of polygon walls and
+//! [`mesh_walls`] the triangles, edges and corners of mesh walls.
 
 pub mod contacts;
 pub mod features;
+pub mod mesh_walls;
 pub mod wall_edges;
 
 use nalgebra::Vector3;

@@ -77,14 +77,23 @@ fn circle_segment(x: &Placed, k: usize, start: &V3, t: &V3, length: f64) -> Opti
     Some((gap.dot(&normal), normal, p, foot))
 }
 
-/// The best valid candidate of the edge (`rod`, inward in-plane normal `inward`) against
-/// piece `i` of the body.
-fn edge_piece(body: &Placed, i: usize, rod: &Rod, inward: &V3) -> Option<Candidate> {
+/// Whether the normal `n` (wall → body) leaves every face holding an edge across it: the
+/// edge is then those faces' closest feature (`inward`: each face's in-plane normal pointing
+/// into it from the edge).
+/// (A margin of 1e-9 keeps the shared edges of flat meshes out.)
+#[inline]
+fn off_every_face(n: &V3, inward: &[V3]) -> bool {
+    inward.iter().all(|e| n.dot(e) < -1e-9)
+}
+
+/// The best valid candidate of the edge `rod` (inward in-plane normals of the faces holding
+/// it: `inward`) against piece `i` of the body.
+fn edge_piece(body: &Placed, i: usize, rod: &Rod, inward: &[V3]) -> Option<Candidate> {
     let mut best: Option<Candidate> = None;
     let mut consider = |c: Candidate| {
         // an overlap is real only where the edge's point lies in the piece
         let real = c.0 >= 0.0 || super::features::inside_piece(body, i, &c.2);
-        if real && c.1.dot(inward) < 0.0 && best.is_none_or(|b| c.0 > b.0) {
+        if real && off_every_face(&c.1, inward) && best.is_none_or(|b| c.0 > b.0) {
             best = Some(c);
         }
     };
@@ -120,6 +129,162 @@ fn edge_piece(body: &Placed, i: usize, rod: &Rod, inward: &V3) -> Option<Candida
     best
 }
 
+/// Contacts of the wall edge from `va` to `vb` (world, m) with a body, wall first, appended
+/// to `out` with weights: the best valid candidate of each piece within reach, each body
+/// feature once, and the line pair of a nearly parallel cylinder. `inward` holds the
+/// in-plane normals of the faces holding the edge (one for a polygon's edge, two for a
+/// mesh's); `key` is the wall-side key of the edge's contacts.
+#[allow(clippy::too_many_arguments)]
+pub fn edge_contacts(
+    va: &V3,
+    vb: &V3,
+    inward: &[V3],
+    key: u64,
+    body: &Placed,
+    out: &mut Vec<ContactPoint>,
+    weights: &mut Vec<f64>,
+) {
+    let length = (vb - va).norm();
+    if length <= 0.0 {
+        return;
+    }
+    let capsule = body.shape.bounding_capsule;
+    let (c0, c1) = (body.at(capsule.z_min), body.at(capsule.z_max));
+    let (s, t, _) = segment_parameters(&c0, &(c1 - c0), va, &(vb - va));
+    if (c0 + (c1 - c0) * s - va - (vb - va) * t).norm() >= capsule.radius {
+        return;
+    }
+    let rod = Rod {
+        start: *va,
+        direction: (vb - va) / length,
+        length,
+        radius: 0.0,
+    };
+    let mut found: Vec<(Candidate, bool)> = Vec::new();
+    let mut lines: Vec<(usize, f64, f64, f64, Option<f64>)> = Vec::new();
+    for i in 0..body.shape.frustums.len() {
+        let piece = piece_rod(body, i);
+        let (s, t, _) = segment_parameters(
+            &piece.start,
+            &(piece.direction * piece.length),
+            va,
+            &(vb - va),
+        );
+        let gap = piece.start + piece.direction * (s * piece.length) - va - (vb - va) * t;
+        if gap.norm() >= body.shape.frustums[i].reach {
+            continue;
+        }
+        let candidate = edge_piece(body, i, &rod, inward);
+        let line = if body.shape.frustums[i].is_cylinder() {
+            line_pair(&piece, &rod)
+        } else {
+            (0.0, 0.0, 0.0)
+        };
+        if line.0 > 0.0 {
+            let sigma = candidate.map(|c| (c.3 - piece.start).dot(&piece.direction));
+            lines.push((i, line.0, line.1, line.2, sigma));
+        }
+        if let Some(c) = candidate {
+            if c.0 < 0.0 {
+                found.push((c, line.0 > 0.0));
+            }
+        }
+    }
+    for k in 0..found.len() {
+        let (c, own) = found[k];
+        if found[..k].iter().any(|f| f.0 .4 == c.4) {
+            continue;
+        }
+        let owned = own || found[k + 1..].iter().any(|f| f.1 && f.0 .4 == c.4);
+        let weight = if owned {
+            1.0
+        } else {
+            1.0 - lines
+                .iter()
+                .filter(|l| belongs_to(body, c.4, l.0))
+                .map(|l| l.1)
+                .fold(0.0, f64::max)
+        };
+        if weight <= 0.0 {
+            continue;
+        }
+        out.push(ContactPoint {
+            point: 0.5 * (c.2 + c.3),
+            normal: c.1,
+            overlap: -c.0,
+            radius_first: f64::INFINITY,
+            radius_second: feature_radius(body, c.4, &c.3, &(-c.1)),
+            feature_first: key,
+            feature_second: c.4.key(),
+        });
+        weights.push(weight);
+    }
+    for &(i, gh, lo, hi, sigma) in &lines {
+        let piece = piece_rod(body, i);
+        for sample in line_samples(&piece, &rod, gh, lo, hi, sigma) {
+            // the sample's normal runs from the body to the edge
+            if sample.overlap > 0.0 && sample.weight > 0.0 && off_every_face(&(-sample.normal), inward)
+            {
+                out.push(ContactPoint {
+                    point: sample.point,
+                    normal: -sample.normal,
+                    overlap: sample.overlap,
+                    radius_first: f64::INFINITY,
+                    radius_second: piece.radius,
+                    feature_first: key,
+                    feature_second: LINE_KEY + 2 * i as u64 + sample.end as u64,
+                });
+                weights.push(sample.weight);
+            }
+        }
+    }
+}
+
+/// The contact of the wall corner `v` (world, m) with a body, wall first, when the corner is
+/// the wall's closest feature to the body (the normal points away from every edge leaving
+/// it: `neighbours` are the other ends of those edges); `key` is its wall-side key.
+pub fn corner_contact(
+    v: &V3,
+    neighbours: &[V3],
+    key: u64,
+    body: &Placed,
+    out: &mut Vec<ContactPoint>,
+    weights: &mut Vec<f64>,
+) {
+    let capsule = body.shape.bounding_capsule;
+    let (z, radial, rho) = body.meridian(v);
+    if z < capsule.z_min - capsule.radius
+        || z > capsule.z_max + capsule.radius
+        || rho > capsule.radius
+    {
+        return;
+    }
+    let (distance, q, normal, radius) = body.shape.meridian_distance(z, rho);
+    if distance >= 0.0 {
+        return;
+    }
+    let outward = body.axis * normal.0 + radial * normal.1;
+    let to_body = -outward;
+    // (strictly: a corner inside a flat mesh is no corner)
+    if neighbours
+        .iter()
+        .any(|w| to_body.dot(&(w - v)) > -1e-9 * (w - v).norm())
+    {
+        return;
+    }
+    let surface = body.origin + body.axis * q.0 + radial * q.1;
+    out.push(ContactPoint {
+        point: 0.5 * (v + surface),
+        normal: to_body,
+        overlap: -distance,
+        radius_first: f64::INFINITY,
+        radius_second: radius,
+        feature_first: key,
+        feature_second: 0,
+    });
+    weights.push(1.0);
+}
+
 /// Contacts of the edges and corners of a convex polygon (world vertices in boundary order,
 /// inward in-plane edge normals) with a body, wall first, appended to `out` with weights.
 pub fn polygon_edge_contacts(
@@ -130,133 +295,12 @@ pub fn polygon_edge_contacts(
     weights: &mut Vec<f64>,
 ) {
     let n = vertices.len();
-    let capsule = body.shape.bounding_capsule;
-    let (c0, c1) = (body.at(capsule.z_min), body.at(capsule.z_max));
-    let mut found: Vec<(Candidate, usize, bool)> = Vec::new();
-    let mut lines: Vec<(usize, usize, f64, f64, f64, Option<f64>)> = Vec::new();
     for e in 0..n {
         let (va, vb) = (vertices[e], vertices[(e + 1) % n]);
-        let length = (vb - va).norm();
-        if length <= 0.0 {
-            continue;
-        }
-        let rod = Rod {
-            start: va,
-            direction: (vb - va) / length,
-            length,
-            radius: 0.0,
-        };
-        let (s, t, _) = segment_parameters(&c0, &(c1 - c0), &va, &(vb - va));
-        if (c0 + (c1 - c0) * s - va - (vb - va) * t).norm() >= capsule.radius {
-            continue;
-        }
-        found.clear();
-        lines.clear();
-        for i in 0..body.shape.frustums.len() {
-            let piece = piece_rod(body, i);
-            let (s, t, _) = segment_parameters(
-                &piece.start,
-                &(piece.direction * piece.length),
-                &va,
-                &(vb - va),
-            );
-            let gap = piece.start + piece.direction * (s * piece.length) - va - (vb - va) * t;
-            if gap.norm() >= body.shape.frustums[i].reach {
-                continue;
-            }
-            let candidate = edge_piece(body, i, &rod, &edge_normals[e]);
-            let line = if body.shape.frustums[i].is_cylinder() {
-                line_pair(&piece, &rod)
-            } else {
-                (0.0, 0.0, 0.0)
-            };
-            if line.0 > 0.0 {
-                let sigma = candidate.map(|c| (c.3 - piece.start).dot(&piece.direction));
-                lines.push((i, e, line.0, line.1, line.2, sigma));
-            }
-            if let Some(c) = candidate {
-                if c.0 < 0.0 {
-                    found.push((c, i, line.0 > 0.0));
-                }
-            }
-        }
-        for k in 0..found.len() {
-            let (c, _, own) = found[k];
-            if found[..k].iter().any(|f| f.0 .4 == c.4) {
-                continue;
-            }
-            let owned = own || found[k + 1..].iter().any(|f| f.2 && f.0 .4 == c.4);
-            let weight = if owned {
-                1.0
-            } else {
-                1.0 - lines
-                    .iter()
-                    .filter(|l| belongs_to(body, c.4, l.0))
-                    .map(|l| l.2)
-                    .fold(0.0, f64::max)
-            };
-            if weight <= 0.0 {
-                continue;
-            }
-            out.push(ContactPoint {
-                point: 0.5 * (c.2 + c.3),
-                normal: c.1,
-                overlap: -c.0,
-                radius_first: f64::INFINITY,
-                radius_second: feature_radius(body, c.4, &c.3, &(-c.1)),
-                feature_first: EDGE_KEY + e as u64,
-                feature_second: c.4.key(),
-            });
-            weights.push(weight);
-        }
-        for &(i, e, gh, lo, hi, sigma) in &lines {
-            let piece = piece_rod(body, i);
-            for sample in line_samples(&piece, &rod, gh, lo, hi, sigma) {
-                // the sample's normal runs from the body to the edge
-                if sample.overlap > 0.0
-                    && sample.weight > 0.0
-                    && (-sample.normal).dot(&edge_normals[e]) < 0.0
-                {
-                    out.push(ContactPoint {
-                        point: sample.point,
-                        normal: -sample.normal,
-                        overlap: sample.overlap,
-                        radius_first: f64::INFINITY,
-                        radius_second: piece.radius,
-                        feature_first: EDGE_KEY + e as u64,
-                        feature_second: LINE_KEY + 2 * i as u64 + sample.end as u64,
-                    });
-                    weights.push(sample.weight);
-                }
-            }
-        }
+        edge_contacts(&va, &vb, &edge_normals[e..e + 1], EDGE_KEY + e as u64, body, out, weights);
     }
     for m in 0..n {
-        let v = vertices[m];
-        let (z, radial, rho) = body.meridian(&v);
-        if z < capsule.z_min - capsule.radius || z > capsule.z_max + capsule.radius {
-            continue;
-        }
-        let (distance, q, normal, radius) = body.shape.meridian_distance(z, rho);
-        if distance >= 0.0 {
-            continue;
-        }
-        let outward = body.axis * normal.0 + radial * normal.1;
-        let to_body = -outward;
-        let (next, previous) = (vertices[(m + 1) % n], vertices[(m + n - 1) % n]);
-        if to_body.dot(&(next - v)) > 0.0 || to_body.dot(&(previous - v)) > 0.0 {
-            continue;
-        }
-        let surface = body.origin + body.axis * q.0 + radial * q.1;
-        out.push(ContactPoint {
-            point: 0.5 * (v + surface),
-            normal: to_body,
-            overlap: -distance,
-            radius_first: f64::INFINITY,
-            radius_second: radius,
-            feature_first: CORNER_KEY + m as u64,
-            feature_second: 0,
-        });
-        weights.push(1.0);
+        let neighbours = [vertices[(m + 1) % n], vertices[(m + n - 1) % n]];
+        corner_contact(&vertices[m], &neighbours, CORNER_KEY + m as u64, body, out, weights);
     }
 }

@@ -55,6 +55,9 @@ pub(crate) struct RevolutionPass {
     pair_scratch: PairScratch,
     clump_scratch: ClumpPairScratch,
     rebuilds: u64,
+    /// The deepest overlap of the last evaluation: (body, partner, partner is a boundary,
+    /// overlap m).
+    deepest: Option<(usize, usize, bool, f64)>,
 }
 
 impl RevolutionPass {
@@ -86,6 +89,33 @@ fn rotation_angle(a: &UnitQuaternion<f64>, b: &UnitQuaternion<f64>) -> f64 {
 }
 
 impl RigidScene {
+    /// Refuse a start configuration in which two bodies, or a body and a wall, overlap by
+    /// more than `tolerance` (m): an error naming `positions`, the bodies and the overlap.
+    /// Evaluates the forces at the current time (as the first step would), so it is checked
+    /// for scenes with bodies of revolution (others pass).
+    pub fn check_start_overlaps(&mut self, tolerance: f64) -> Result<()> {
+        if self.revolution.is_none() || self.bodies.is_empty() {
+            return Ok(());
+        }
+        self.compute_forces(self.time)?;
+        let deepest = self.revolution.as_ref().and_then(|p| p.deepest);
+        match deepest {
+            Some((body, partner, wall, overlap)) if overlap > tolerance => {
+                let what = if wall {
+                    format!("body {body} and wall {partner}")
+                } else {
+                    format!("bodies {body} and {partner}")
+                };
+                Err(DemfemError::InvalidParameter {
+                    field: "positions".into(),
+                    value: format!("{what} overlapping by {overlap:e} m"),
+                    allowed: format!("start poses apart (overlaps up to {tolerance:e} m)"),
+                })
+            }
+            _ => Ok(()),
+        }
+    }
+
     /// Rebuild the candidate pairs when needed (see the module docs).
     fn refresh_pairs(&mut self) {
         let n = self.bodies.len();
@@ -213,6 +243,7 @@ impl RigidScene {
             pass.wall_touching.resize(n * n_boundaries, false);
         }
         pass.springs_next.clear();
+        pass.deepest = None;
         self.coordination.iter_mut().for_each(|c| *c = 0);
         self.wall_contacts.iter_mut().for_each(|c| *c = 0);
         let mut count = 0;
@@ -272,13 +303,14 @@ impl RigidScene {
                     (Some((PreparedShape::Mesh(mesh), offset)), RigidShape::Clump(clump)) => {
                         clump_mesh_contacts(mesh, &offset, clump, &pose, &mut contacts)
                     }
-                    (Some((PreparedShape::Mesh(_), _)), RigidShape::Revolution(_)) => {
-                        return Err(DemfemError::ShapeMismatch {
-                            field: format!("walls[{}]", p - n_planes),
-                            detail: "a mesh wall takes bead clumps and spheres, not bodies of \
-                                     revolution (yet)"
-                                .into(),
-                        });
+                    (Some((PreparedShape::Mesh(mesh), offset)), RigidShape::Revolution(r)) => {
+                        crate::rigid::revolution::mesh_walls::mesh_contacts(
+                            mesh,
+                            &offset,
+                            &placed(r, &pose),
+                            &mut contacts,
+                            &mut weights,
+                        )
                     }
                     (_, RigidShape::Exact(_)) => return Err(mixed_exact()),
                 }
@@ -301,6 +333,10 @@ impl RigidScene {
                     self.onsets.push(onset(time, i, p, true, &relative, &c0.normal));
                 }
                 pass.wall_touching[slot] = true;
+                let overlap = contacts[deepest].overlap;
+                if pass.deepest.is_none_or(|d| overlap > d.3) {
+                    pass.deepest = Some((i, p, true, overlap));
+                }
                 for (c, &w) in contacts.iter().zip(&weights) {
                     max_overlap = max_overlap.max(c.overlap);
                     let relative = self.bodies.point_velocity(i, &c.point) - surface_velocity;
@@ -391,6 +427,10 @@ impl RigidScene {
                 self.onsets.push(o);
             }
             pass.pair_touching[k] = true;
+            let overlap = contacts[deepest].overlap;
+            if pass.deepest.is_none_or(|d| overlap > d.3) {
+                pass.deepest = Some((a, b, false, overlap));
+            }
             self.coordination[a] += 1;
             self.coordination[b] += 1;
             count += contacts.len();
