@@ -613,3 +613,22 @@ def test_a_binary_scene_file_is_refused_naming_it(tmp_path, capsys):
     assert main(["run", str(path), "--out", str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err
     assert "scene.toml" in err and err.count("\n") == 1 and "Traceback" not in err
+
+
+def test_dem_step_count_beyond_63_bits_names_n():
+    """``DemSimulation.step(2**64 - 1)``: an error naming ``n`` and its limit, not Python's raw
+    OverflowError; a non-integer keeps its TypeError."""
+    from demfem.dem import from_scene
+    from demfem.errors import InvalidParameterError
+    from demfem.scenes.table import AccumulationTable
+
+    sim = from_scene(AccumulationTable(width=0.1, length=0.1, tilted_wall_length=0.05,
+                                       n_spheres=30).build())
+    with pytest.raises(InvalidParameterError, match=r"\bn\b.*2\^63"):
+        sim.step(2**64 - 1)
+    with pytest.raises(InvalidParameterError, match=r"\bn\b"):
+        sim.step(-(2**70))
+    with pytest.raises(TypeError):
+        sim.step("ten")
+    sim.step(3)
+    assert sim.steps == 3

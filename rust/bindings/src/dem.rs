@@ -18,7 +18,7 @@ use crate::convert::{
 use crate::dem_events::event_columns;
 use crate::dem_walls::parse_wall;
 use crate::error::{invalid, shape_err, CoreResult, PyDemfemError};
-use crate::run::{checked_steps, run_in_chunks, steps_until};
+use crate::run::{checked_steps, run_in_chunks, step_count_arg, steps_until};
 
 /// Largest time step a DEM simulation accepts, s: with no particles (or no stiffness) the
 /// stable limit is infinite, and a step beyond this is a mistake, not a DEM step.
@@ -305,8 +305,8 @@ impl DemSimulation {
     /// Advance `n` steps, releasing the GIL in chunks of `chunk` steps; Ctrl-C between chunks
     /// raises SimulationInterrupted with the state consistent at a step boundary.
     #[pyo3(signature = (n, chunk=2000))]
-    fn step(&mut self, py: Python<'_>, n: i64, chunk: i64) -> PyResult<()> {
-        let n = checked_steps(n, self.sim.time(), self.sim.dt())?;
+    fn step(&mut self, py: Python<'_>, n: &Bound<'_, PyAny>, chunk: i64) -> PyResult<()> {
+        let n = checked_steps(step_count_arg(n)?, self.sim.time(), self.sim.dt())?;
         let chunk = count("chunk", chunk)?;
         run_in_chunks(
             py,

@@ -86,6 +86,21 @@ pub(crate) fn steps_until(t_end: f64, time: f64, dt: f64) -> PyResult<u64> {
 }
 
 /// Steps `n` (from Python, signed) checked: >= 0, and the simulated time after them finite.
+/// A step count given from Python as any integer: one that does not fit in 63 bits is an
+/// error naming `n` and the limit (not Python's raw OverflowError); a non-integer keeps its
+/// TypeError.
+pub(crate) fn step_count_arg(n: &Bound<'_, PyAny>) -> PyResult<i64> {
+    match n.extract::<i64>() {
+        Ok(v) => Ok(v),
+        Err(e) if n.is_instance_of::<pyo3::types::PyInt>() => {
+            let shown = n.repr().map(|r| r.to_string()).unwrap_or_else(|_| "?".into());
+            drop(e);
+            Err(invalid("n", &shown, "a whole number of steps below 2^63"))
+        }
+        Err(e) => Err(e),
+    }
+}
+
 pub(crate) fn checked_steps(n: i64, time: f64, dt: f64) -> PyResult<u64> {
     let n = count("n", n)?;
     if !(time + n as f64 * dt).is_finite() {
