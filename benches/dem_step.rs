@@ -15,7 +15,7 @@ use criterion::measurement::WallTime;
 use criterion::{criterion_group, criterion_main, BenchmarkGroup, Criterion, Throughput};
 use demfem::contact::reissner_stiffness;
 use demfem::dem::table::{anchor_scene, TableStart};
-use demfem::dem::{ContactModel, Effect, Scene, Simulation};
+use demfem::dem::{DemContactLaw, Effect, Scene, Simulation};
 use demfem::geometry::Vec3;
 use std::time::Duration;
 
@@ -179,7 +179,7 @@ fn bench_series_law(c: &mut Criterion, scene: &Scene) {
         let mut s = scene.clone();
         s.threads = 1;
         if series {
-            s.model = ContactModel::HertzReissnerMindlin;
+            s.model = DemContactLaw::HertzReissnerMindlin;
             for m in s.materials.iter_mut() {
                 m.shell_stiffness =
                     reissner_stiffness(m.young_modulus, m.poisson_ratio, 1.1e-3, 5.25e-3)

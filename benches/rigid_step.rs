@@ -11,7 +11,7 @@ use std::collections::HashMap;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use demfem::rigid::{
-    BeadClump, ContactMaterial, ContactModel, ContactPoint, MassProperties, Plane, RigidScene,
+    BeadClump, ContactMaterial, RigidContactLaw, ContactPoint, MassProperties, Plane, RigidScene,
     RigidSceneConfig, RigidShape,
 };
 use nalgebra::{UnitQuaternion, Vector3};
@@ -77,7 +77,7 @@ struct SphereLoop {
     mass: f64,
     inertia: f64,
     belt: Plane,
-    model: ContactModel,
+    model: RigidContactLaw,
     dt: f64,
     history: HashMap<(usize, usize), Vector3<f64>>,
     history_next: HashMap<(usize, usize), Vector3<f64>>,
@@ -99,7 +99,7 @@ impl SphereLoop {
                 )
             })
             .collect();
-        let model = ContactModel::new(
+        let model = RigidContactLaw::new(
             ContactMaterial::PAPER_GLASS,
             ContactMaterial::PAPER_GLASS,
             0.5,

@@ -16,9 +16,9 @@ mod rigid_common;
 
 use common::alternating_triangles;
 use demfem::dem::table::{anchor_scene, TableStart};
-use demfem::dem::{ContactModel as DemLaw, Simulation};
+use demfem::dem::{DemContactLaw as DemLaw, Simulation};
 use demfem::fem::contact::{
-    ContactModel, ContactSettings, NoTensionSpring, RigidShape, RigidSurface,
+    FemContact, ContactSettings, NoTensionSpring, RigidShape, RigidSurface,
 };
 use demfem::fem::mesh::{box_tet_mesh, place, union, TriMesh};
 use demfem::fem::shell::{ShellExplicit, ShellModel};
@@ -80,7 +80,7 @@ fn peaks(history: &[f64], channels: usize) -> Vec<f64> {
 
 /// Two upright glass tubes side by side on the belt, the second closing on the first at
 /// 0.18 m/s, friction 0.2, gravity, no-tension springs on a few nodes of the first.
-fn tet_cluster() -> (ExplicitSolver, ContactModel, Vec<[f64; 3]>) {
+fn tet_cluster() -> (ExplicitSolver, FemContact, Vec<[f64; 3]>) {
     let mat = glass();
     let tube = AxisymmetricProfile::tube(4.7e-3, 5.8e-3, 12e-3)
         .unwrap()
@@ -101,7 +101,7 @@ fn tet_cluster() -> (ExplicitSolver, ContactModel, Vec<[f64; 3]>) {
         output_interval: 5,
         ..Default::default()
     };
-    let mut c = ContactModel::new(&mesh, &body, &region, &mat, settings).unwrap();
+    let mut c = FemContact::new(&mesh, &body, &region, &mat, settings).unwrap();
     c.add_rigid(belt(0.2)).unwrap();
     let springs: Vec<NoTensionSpring> = (0..n)
         .filter(|&i| body[i] == 0 && mesh.nodes[i][0] < -5.7e-3)
@@ -354,7 +354,7 @@ fn shell_cluster_setup() -> (ShellModel, ShellExplicit) {
         output_interval: 5,
         ..Default::default()
     };
-    let mut c = ContactModel::new_shell(&mesh, &body, &region, &mat, settings).unwrap();
+    let mut c = FemContact::new_shell(&mesh, &body, &region, &mat, settings).unwrap();
     c.add_rigid(belt(0.2)).unwrap();
     let springs: Vec<NoTensionSpring> = (0..nn)
         .filter(|&i| body[i] == 0 && mesh.nodes[i][0] < -5.2e-3)

@@ -9,7 +9,7 @@ use dem_support::bits;
 use demfem::contact::reissner_stiffness;
 use demfem::dem::table::{anchor_scene, TableStart};
 use demfem::dem::{
-    ContactModel, Effect, EffectSet, Material, ParticleInit, Partner, Scene, Simulation,
+    DemContactLaw, Effect, EffectSet, Material, ParticleInit, Partner, Scene, Simulation,
 };
 use demfem::geometry::{Vec3, WallMotion};
 
@@ -28,7 +28,7 @@ fn packed_soft_hertz_reissner(threads: usize) -> Simulation {
     let mut scene = anchor_scene(1e8, TableStart::PackedIntoFunnel).unwrap();
     scene.threads = threads;
     scene.record_onsets = true;
-    scene.model = ContactModel::HertzReissnerMindlin;
+    scene.model = DemContactLaw::HertzReissnerMindlin;
     for m in scene.materials.iter_mut() {
         m.shell_stiffness = reissner_stiffness(1e8, m.poisson_ratio, 1.1e-3, 5.25e-3).unwrap();
     }

@@ -5,7 +5,7 @@
 mod dem_support;
 use dem_support::*;
 
-use demfem::dem::{ContactModel, Effect, EffectSet, Simulation};
+use demfem::dem::{DemContactLaw, Effect, EffectSet, Simulation};
 use demfem::geometry::Vec3;
 
 fn impact(sim: &mut Simulation) -> (f64, f64) {
@@ -55,7 +55,7 @@ fn hertz_reissner_impact_force_matches_energy_balance() {
         vec![mat, rigid(nu, 0.0, 1.0)],
         EffectSet::empty(),
     );
-    scene.model = ContactModel::HertzReissnerMindlin;
+    scene.model = DemContactLaw::HertzReissnerMindlin;
     // the soft shell dominates: contact time ≈ π √(m/k_R)
     scene.time_step = Some(std::f64::consts::PI * (m / k_r).sqrt() / 1000.0);
     let mut sim = Simulation::new(&scene).unwrap();
@@ -84,7 +84,7 @@ fn linear_spring_dashpot_matches_damped_oscillator() {
         vec![material(45e9, 0.22, rho, 0.0, e), rigid(0.22, 0.0, e)],
         EffectSet::of(&[Effect::Damping]),
     );
-    scene.model = ContactModel::LinearSpringDashpot {
+    scene.model = DemContactLaw::LinearSpringDashpot {
         normal_stiffness: k_n,
         tangential_stiffness: 0.8 * k_n,
     };
@@ -164,7 +164,7 @@ fn hr_oscillation(
     mat.shell_stiffness = k_r;
     let floor = rigid(nu, mu, rest);
     let mut scene = sphere_on_floor(r, r - delta0, kick, Vec3::ZERO, vec![mat, floor], effects);
-    scene.model = ContactModel::HertzReissnerMindlin;
+    scene.model = DemContactLaw::HertzReissnerMindlin;
     scene.gravity = Vec3::new(0.0, 0.0, -g);
     scene.time_step = Some(dt);
     let mut sim = Simulation::new(&scene).unwrap();

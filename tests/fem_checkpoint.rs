@@ -6,7 +6,7 @@
 
 use demfem::error::DemfemError;
 use demfem::fem::contact::{
-    ContactModel, ContactSettings, NoTensionSpring, RigidShape, RigidSurface,
+    FemContact, ContactSettings, NoTensionSpring, RigidShape, RigidSurface,
 };
 use demfem::fem::mesh::{ball_tet_mesh, place, union};
 use demfem::fem::{ExplicitConfig, ExplicitSolver, LinearElastic};
@@ -29,7 +29,7 @@ fn build(n: usize) -> ExplicitSolver {
         ..Default::default()
     };
     let region = vec![0; mesh.nodes.len()];
-    let mut c = ContactModel::new(&mesh, &body, &region, &mat, settings).unwrap();
+    let mut c = FemContact::new(&mesh, &body, &region, &mat, settings).unwrap();
     c.add_rigid(RigidSurface {
         shape: RigidShape::Plane {
             point: [0.0; 3],

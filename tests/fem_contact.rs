@@ -5,7 +5,7 @@
 //! conservation, convergence in the penalty scale, and bitwise equality on 1 and 2 threads.
 
 use demfem::fem::contact::{
-    ContactModel, ContactSettings, NoTensionSpring, RigidShape, RigidSurface,
+    FemContact, ContactSettings, NoTensionSpring, RigidShape, RigidSurface,
 };
 use demfem::fem::mesh::{ball_tet_mesh, box_tet_mesh, place, union};
 use demfem::fem::{ExplicitConfig, ExplicitSolver, LinearElastic, LoadHistory, TetMesh};
@@ -74,7 +74,7 @@ fn impact(r: f64, n: usize, v: f64, scale: f64, two_balls: bool) -> Impact {
         ..Default::default()
     };
     let region = vec![0; mesh.nodes.len()];
-    let mut c = ContactModel::new(&mesh, &body, &region, &mat, settings).unwrap();
+    let mut c = FemContact::new(&mesh, &body, &region, &mat, settings).unwrap();
     if !two_balls {
         c.add_rigid(RigidSurface {
             shape: RigidShape::Plane {
@@ -106,9 +106,9 @@ fn impact(r: f64, n: usize, v: f64, scale: f64, two_balls: bool) -> Impact {
     let m = mat.density * 4.0 / 3.0 * std::f64::consts::PI * r * r * r;
     let nu2 = 1.0 - mat.poisson_ratio * mat.poisson_ratio;
     let (_, t_h) = if two_balls {
-        hertz(mat.youngs_modulus / (2.0 * nu2), 0.5 * r, 0.5 * m, v)
+        hertz(mat.young_modulus / (2.0 * nu2), 0.5 * r, 0.5 * m, v)
     } else {
-        hertz(mat.youngs_modulus / nu2, r, m, v)
+        hertz(mat.young_modulus / nu2, r, m, v)
     };
     let steps = (2.0 * t_h / s.dt()).ceil() as u64;
     s.run(steps).unwrap();
@@ -167,7 +167,7 @@ fn elastic_ball_on_a_rigid_plane_follows_hertz_impact() {
     let (r, v) = (0.01, 2.0);
     let mat = soft();
     let m = mat.density * 4.0 / 3.0 * std::f64::consts::PI * r * r * r;
-    let e_star = mat.youngs_modulus / (1.0 - mat.poisson_ratio * mat.poisson_ratio);
+    let e_star = mat.young_modulus / (1.0 - mat.poisson_ratio * mat.poisson_ratio);
     let (f_h, t_h) = hertz(e_star, r, m, v);
     let out = impact(r, 8, v, 1.0, false);
     let ef = out.peak / f_h - 1.0;
@@ -185,7 +185,7 @@ fn two_equal_balls_head_on_follow_hertz_and_conserve_momentum() {
     let (r, v) = (0.01, 2.0);
     let mat = soft();
     let m = mat.density * 4.0 / 3.0 * std::f64::consts::PI * r * r * r;
-    let e_star = mat.youngs_modulus / (2.0 * (1.0 - mat.poisson_ratio * mat.poisson_ratio));
+    let e_star = mat.young_modulus / (2.0 * (1.0 - mat.poisson_ratio * mat.poisson_ratio));
     let (f_h, t_h) = hertz(e_star, 0.5 * r, 0.5 * m, v);
     let out = impact(r, 8, v, 1.0, true);
     let ef = out.peak / f_h - 1.0;
@@ -247,7 +247,7 @@ fn block(pull: f64, belt: f64, mu: f64, duration: f64) -> (ExplicitSolver, f64) 
         friction: mu,
         ..Default::default()
     };
-    let mut c = ContactModel::new(&mesh, &vec![0; n], &vec![0; n], &mat, settings).unwrap();
+    let mut c = FemContact::new(&mesh, &vec![0; n], &vec![0; n], &mat, settings).unwrap();
     c.add_rigid(RigidSurface {
         shape: RigidShape::Plane {
             point: [0.0; 3],
@@ -326,7 +326,7 @@ fn no_tension_springs_push_and_never_pull() {
     let mesh = box_tet_mesh(0.01, 0.01, 0.01, 1, 1, 1).unwrap();
     let n = mesh.nodes.len();
     let mut solver = ExplicitSolver::new(&mesh, ExplicitConfig::new(mat)).unwrap();
-    let mut c = ContactModel::new(&mesh, &vec![0; n], &vec![0; n], &mat, ContactSettings::default()).unwrap();
+    let mut c = FemContact::new(&mesh, &vec![0; n], &vec![0; n], &mat, ContactSettings::default()).unwrap();
     c.add_springs(&[NoTensionSpring {
         node: 0,
         anchor: [-0.001, 0.0, 0.0],
@@ -356,7 +356,7 @@ fn bad_contact_input_is_refused_with_the_field_named() {
     let mesh = box_tet_mesh(0.01, 0.01, 0.01, 1, 1, 1).unwrap();
     let n = mesh.nodes.len();
     let bad = |settings: ContactSettings| {
-        ContactModel::new(&mesh, &vec![0; n], &vec![0; n], &mat, settings)
+        FemContact::new(&mesh, &vec![0; n], &vec![0; n], &mat, settings)
             .unwrap_err()
             .to_string()
     };
@@ -364,7 +364,7 @@ fn bad_contact_input_is_refused_with_the_field_named() {
     assert!(bad(ContactSettings { friction: -0.1, ..d }).contains("friction"));
     assert!(bad(ContactSettings { friction: f64::NAN, ..d }).contains("friction"));
     assert!(bad(ContactSettings { penalty_scale: 0.0, ..d }).contains("penalty_scale"));
-    let mut c = ContactModel::new(&mesh, &vec![0; n], &vec![0; n], &mat, d).unwrap();
+    let mut c = FemContact::new(&mesh, &vec![0; n], &vec![0; n], &mat, d).unwrap();
     let e = c
         .add_springs(&[NoTensionSpring {
             node: 0,
@@ -379,7 +379,7 @@ fn bad_contact_input_is_refused_with_the_field_named() {
     let a = box_tet_mesh(0.01, 0.01, 0.01, 2, 2, 2).unwrap();
     let b = place(&a, I3, [0.0097, 0.0, 0.0]).unwrap();
     let (m2, body) = union(&[a, b]);
-    let c = ContactModel::new(&m2, &body, &vec![0; m2.nodes.len()], &mat, d).unwrap();
+    let c = FemContact::new(&m2, &body, &vec![0; m2.nodes.len()], &mat, d).unwrap();
     let mut s = ExplicitSolver::new(&m2, ExplicitConfig::new(mat)).unwrap();
     let e = s.set_contact(c).unwrap_err().to_string();
     assert!(e.contains("overlaps") && e.contains("body"), "{e}");

@@ -18,7 +18,7 @@ const P: f64 = 1e6; // internal pressure, Pa
 /// Lamé plane strain: u_r(r) = (1+ν)/E · a²p/(b²−a²) · ((1−2ν) r + b²/r).
 fn lame_ur(m: &LinearElastic, r: f64) -> f64 {
     let nu = m.poisson_ratio;
-    (1.0 + nu) / m.youngs_modulus * A * A * P / (B * B - A * A) * ((1.0 - 2.0 * nu) * r + B * B / r)
+    (1.0 + nu) / m.young_modulus * A * A * P / (B * B - A * A) * ((1.0 - 2.0 * nu) * r + B * B / r)
 }
 /// Lamé hoop stress σ_θ(r) = a²p/(b²−a²) (1 + b²/r²).
 fn lame_hoop(r: f64) -> f64 {
@@ -125,7 +125,7 @@ fn lame_explicit_tends_to_static() {
     let loads = inner_pressure(&rm);
     let stat = solve_static(&rm.mesh, &m, &loads, &cons).unwrap();
     let r = 0.5 * (A + B);
-    let omega = (m.youngs_modulus / (m.density * (1.0 - m.poisson_ratio.powi(2)))).sqrt() / r;
+    let omega = (m.young_modulus / (m.density * (1.0 - m.poisson_ratio.powi(2)))).sqrt() / r;
     let mut cfg = ExplicitConfig::new(m);
     cfg.rayleigh_alpha = omega; // ζ = α/(2ω) = 0.5
     cfg.energy_interval = 1;
@@ -185,7 +185,7 @@ fn thin_ring_breathing_frequency() {
         .tet_mesh(64, 2, 0.5e-3)
         .unwrap();
     let r = 0.5 * (ri + ro);
-    let omega = (m.youngs_modulus / (m.density * (1.0 - m.poisson_ratio.powi(2)))).sqrt() / r;
+    let omega = (m.young_modulus / (m.density * (1.0 - m.poisson_ratio.powi(2)))).sqrt() / r;
     let mut s = ExplicitSolver::new(&rm.mesh, ExplicitConfig::new(m)).unwrap();
     let mut pres = Vec::new();
     for node in 0..rm.mesh.nodes.len() {

@@ -279,7 +279,7 @@ fn explicit_shell_cantilever_first_frequency() {
     }
     let u0 = model.solve_static(&f, &fixed_vals).unwrap();
     let tip = 6 * nx + 2;
-    let ei = mat.youngs_modulus * b * h.powi(3) / 12.0;
+    let ei = mat.young_modulus * b * h.powi(3) / 12.0;
     // Static tip deflection against P L³/(3EI), as a check of the initial state (1 %).
     let w_static = 1.0 * l.powi(3) / (3.0 * ei);
     assert!(

@@ -1,4 +1,4 @@
-//! Explicit shell contact (`ContactModel::new_shell` with `ShellExplicit`) against closed
+//! Explicit shell contact (`FemContact::new_shell` with `ShellExplicit`) against closed
 //! forms and conservation laws: a flat plate bouncing on a rigid plane (each node a
 //! spring-mass oscillator of the same frequency), two shell tubes colliding free (momentum
 //! to round-off, energy balance, 1 vs 2 threads bitwise, checkpoint), a plate resting on a
@@ -10,7 +10,7 @@ mod common;
 use common::{alternating_triangles, grid};
 use demfem::error::DemfemError;
 use demfem::fem::contact::{
-    ContactModel, ContactSettings, NoTensionSpring, RigidShape, RigidSurface,
+    FemContact, ContactSettings, NoTensionSpring, RigidShape, RigidSurface,
 };
 use demfem::fem::mesh::TriMesh;
 use demfem::fem::shell::{ShellExplicit, ShellModel};
@@ -95,12 +95,12 @@ fn a_flat_shell_plate_bounces_off_a_rigid_plane_as_a_spring_mass() {
         penalty_scale: scale,
         ..frictionless()
     };
-    let mut c = ContactModel::new_shell(&mesh, &vec![0; nn], &vec![0; nn], &mat, settings).unwrap();
+    let mut c = FemContact::new_shell(&mesh, &vec![0; nn], &vec![0; nn], &mat, settings).unwrap();
     c.add_rigid(plane(0.0, [0.0; 3])).unwrap();
     s.set_contact(c).unwrap();
     let m: f64 = s.node_mass().iter().sum();
     let area_tri = 0.5 * (a / n as f64).powi(2);
-    let duration = PI * (mat.density * area_tri / (scale * mat.youngs_modulus)).sqrt();
+    let duration = PI * (mat.density * area_tri / (scale * mat.young_modulus)).sqrt();
     let t_touch = 2e-6 / v0;
     let steps = ((t_touch + 1.5 * duration) / s.dt()).ceil() as u64;
     let (mut first, mut last) = (f64::NAN, f64::NAN);
@@ -169,7 +169,7 @@ fn collide(threads: usize) -> Collision {
         output_interval: 1,
         ..Default::default()
     };
-    let c = ContactModel::new_shell(&mesh, &body, &vec![0; nn], &mat, settings).unwrap();
+    let c = FemContact::new_shell(&mesh, &body, &vec![0; nn], &mat, settings).unwrap();
     let mut s = ShellExplicit::new(&model, &[], None).unwrap();
     let mut v = vec![0.0; 6 * nn];
     for i in 0..nn {
@@ -258,7 +258,7 @@ fn two_shell_tubes_collide_conserving_momentum_and_energy() {
         output_interval: 1,
         ..Default::default()
     };
-    let c = ContactModel::new_shell(&mesh, &body, &vec![0; nn], &mat, settings).unwrap();
+    let c = FemContact::new_shell(&mesh, &body, &vec![0; nn], &mat, settings).unwrap();
     let mut s = ShellExplicit::new(&model, &[], None).unwrap();
     s.set_contact(c).unwrap();
     s.restore_state(&one.saved).unwrap();
@@ -287,7 +287,7 @@ fn a_shell_plate_on_the_belt_carries_its_weight_and_is_dragged_at_mu_n() {
     let (a, h, n) = (0.01, 1e-3, 6);
     let g = 9.81;
     let area_tri = 0.5 * (a / n as f64).powi(2);
-    let delta = g * mat.density * area_tri / mat.youngs_modulus;
+    let delta = g * mat.density * area_tri / mat.young_modulus;
     let mesh = grid(n, n, h, |s, t| [s * a, t * a, 0.5 * h - delta]);
     let nn = mesh.nodes.len();
     let model = ShellModel::new(mesh.clone(), mat).unwrap();
@@ -300,7 +300,7 @@ fn a_shell_plate_on_the_belt_carries_its_weight_and_is_dragged_at_mu_n() {
         initial_overlap_tolerance: 2.0 * delta,
         ..Default::default()
     };
-    let mut c = ContactModel::new_shell(&mesh, &vec![0; nn], &vec![0; nn], &mat, settings).unwrap();
+    let mut c = FemContact::new_shell(&mesh, &vec![0; nn], &vec![0; nn], &mat, settings).unwrap();
     c.add_rigid(plane(mu, [1.0, 0.0, 0.0])).unwrap();
     s.set_contact(c).unwrap();
     let m: f64 = s.node_mass().iter().sum();
@@ -359,7 +359,7 @@ fn a_clamped_shell_plate_under_a_sphere_follows_the_point_load_closed_form() {
         }
     }
     let mut s = ShellExplicit::new(&model, &fixed, None).unwrap();
-    let d_plate = mat.youngs_modulus * h.powi(3) / (12.0 * (1.0 - 0.09));
+    let d_plate = mat.young_modulus * h.powi(3) / (12.0 * (1.0 - 0.09));
     // First period of the clamped square plate: ω = 35.99 √(D/(ρ t)) / a².
     let omega = 35.99 * (d_plate / (mat.density * h)).sqrt() / (a * a);
     let period = 2.0 * PI / omega;
@@ -369,7 +369,7 @@ fn a_clamped_shell_plate_under_a_sphere_follows_the_point_load_closed_form() {
     let vs = w_end / travel_time;
     let centre = (n / 2) * (n + 1) + n / 2;
     let mut c =
-        ContactModel::new_shell(&mesh, &vec![0; nn], &vec![0; nn], &mat, frictionless()).unwrap();
+        FemContact::new_shell(&mesh, &vec![0; nn], &vec![0; nn], &mat, frictionless()).unwrap();
     c.add_rigid(RigidSurface {
         shape: RigidShape::Sphere {
             center: [0.5 * a, 0.5 * a, 0.5 * h + r_s + 1e-7],
@@ -426,7 +426,7 @@ fn bad_shell_contact_input_is_refused() {
     bad.thickness[3] = 0.0;
     let nb = bad.nodes.len();
     expect_invalid(
-        ContactModel::new_shell(&bad, &vec![0; nb], &vec![0; nb], &mat, frictionless()),
+        FemContact::new_shell(&bad, &vec![0; nb], &vec![0; nb], &mat, frictionless()),
         &["thickness", "triangle 3"],
     );
     // Two plates 0.6 t apart: their contact surfaces overlap by 0.4 t.
@@ -435,7 +435,7 @@ fn bad_shell_contact_input_is_refused() {
     let (mesh, body) = join(&a, &b);
     let nn = mesh.nodes.len();
     let model = ShellModel::new(mesh.clone(), mat).unwrap();
-    let c = ContactModel::new_shell(&mesh, &body, &vec![0; nn], &mat, frictionless()).unwrap();
+    let c = FemContact::new_shell(&mesh, &body, &vec![0; nn], &mat, frictionless()).unwrap();
     let mut s = ShellExplicit::new(&model, &[], None).unwrap();
     expect_invalid(s.set_contact(c), &["body 0 overlaps body 1 by 4.0000"]);
     // On the plane, deeper than half the thickness.
@@ -443,7 +443,7 @@ fn bad_shell_contact_input_is_refused() {
     let nl = low.nodes.len();
     let ml = ShellModel::new(low.clone(), mat).unwrap();
     let mut c =
-        ContactModel::new_shell(&low, &vec![0; nl], &vec![0; nl], &mat, frictionless()).unwrap();
+        FemContact::new_shell(&low, &vec![0; nl], &vec![0; nl], &mat, frictionless()).unwrap();
     c.add_rigid(plane(0.0, [0.0; 3])).unwrap();
     let mut s = ShellExplicit::new(&ml, &[], None).unwrap();
     expect_invalid(s.set_contact(c), &["penetrates rigid surface"]);
@@ -452,13 +452,13 @@ fn bad_shell_contact_input_is_refused() {
     let mh = ShellModel::new(high.clone(), mat).unwrap();
     let free = ShellExplicit::new(&mh, &[], None).unwrap();
     let mut c =
-        ContactModel::new_shell(&high, &vec![0; nl], &vec![0; nl], &mat, frictionless()).unwrap();
+        FemContact::new_shell(&high, &vec![0; nl], &vec![0; nl], &mat, frictionless()).unwrap();
     c.add_rigid(plane(0.0, [0.0; 3])).unwrap();
     let mut s = ShellExplicit::new(&mh, &[], Some(0.99 * free.dt_limit())).unwrap();
     expect_invalid(s.set_contact(c), &["contact allowance"]);
     // Springs on a node that does not exist.
     let mut c =
-        ContactModel::new_shell(&high, &vec![0; nl], &vec![0; nl], &mat, frictionless()).unwrap();
+        FemContact::new_shell(&high, &vec![0; nl], &vec![0; nl], &mat, frictionless()).unwrap();
     expect_invalid(
         c.add_springs(&[NoTensionSpring {
             node: 999,
@@ -471,7 +471,7 @@ fn bad_shell_contact_input_is_refused() {
     // A contact model of a solid mesh.
     let tet = demfem::fem::mesh::box_tet_mesh(0.01, 0.01, 0.01, 1, 1, 1).unwrap();
     let nt = tet.nodes.len();
-    let ct = ContactModel::new(&tet, &vec![0; nt], &vec![0; nt], &mat, frictionless()).unwrap();
+    let ct = FemContact::new(&tet, &vec![0; nt], &vec![0; nt], &mat, frictionless()).unwrap();
     let mut s = ShellExplicit::new(&mh, &[], None).unwrap();
     expect_invalid(s.set_contact(ct), &["new_shell"]);
     // Initial velocity on a fixed dof.
@@ -510,7 +510,7 @@ fn no_tension_springs_on_shell_nodes_push_back_a_plate() {
         })
         .collect();
     let mut c =
-        ContactModel::new_shell(&mesh, &vec![0; nn], &vec![0; nn], &mat, frictionless()).unwrap();
+        FemContact::new_shell(&mesh, &vec![0; nn], &vec![0; nn], &mat, frictionless()).unwrap();
     c.add_springs(&springs).unwrap();
     let v0 = 0.2;
     s.set_uniform_velocity([0.0, 0.0, -v0]).unwrap();
@@ -557,7 +557,7 @@ fn shell_faces_take_contact_on_either_side() {
             penalty_scale: 0.01,
             ..frictionless()
         };
-        let c = ContactModel::new_shell(&mesh, &body, &vec![0; nn], &mat, settings).unwrap();
+        let c = FemContact::new_shell(&mesh, &body, &vec![0; nn], &mat, settings).unwrap();
         let mut s = ShellExplicit::new(&model, &[], None).unwrap();
         let mut v = vec![0.0; 6 * nn];
         for i in 0..nn {
@@ -612,7 +612,7 @@ fn shell_tubes_meeting_ridge_to_ridge_touch_at_the_offset_distance() {
     let (mesh, body) = join(&a, &b);
     let nn = mesh.nodes.len();
     let model = ShellModel::new(mesh.clone(), mat).unwrap();
-    let c = ContactModel::new_shell(&mesh, &body, &vec![0; nn], &mat, frictionless()).unwrap();
+    let c = FemContact::new_shell(&mesh, &body, &vec![0; nn], &mat, frictionless()).unwrap();
     let mut s = ShellExplicit::new(&model, &[], None).unwrap();
     let v = 0.5;
     let mut v0 = vec![0.0; 6 * nn];

@@ -230,22 +230,30 @@ def fem_shell_mesh(
 def fem_solve_static(
     nodes: npt.NDArray[np.float64],
     tets: npt.NDArray[np.int64],
-    youngs_modulus: float,
-    poisson_ratio: float,
-    loads: npt.NDArray[np.float64],
-    fixed_dofs: npt.NDArray[np.int64],
-    fixed_values: npt.NDArray[np.float64],
+    young_modulus: float | None = None,
+    poisson_ratio: float | None = None,
+    loads: npt.NDArray[np.float64] | None = None,
+    fixed_dofs: npt.NDArray[np.int64] | None = None,
+    fixed_values: npt.NDArray[np.float64] | None = None,
+    *,
+    youngs_modulus: float | None = None,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
-    """Sparse Cholesky solve K u = f: (u (N,3) m, reactions (N,3) N). E in Pa."""
+    """Sparse Cholesky solve K u = f: (u (N,3) m, reactions (N,3) N). E in Pa.
+
+    Every argument is required; ``youngs_modulus`` is the old name of ``young_modulus``."""
 
 def fem_element_stresses(
     nodes: npt.NDArray[np.float64],
     tets: npt.NDArray[np.int64],
-    youngs_modulus: float,
-    poisson_ratio: float,
-    u: npt.NDArray[np.float64],
+    young_modulus: float | None = None,
+    poisson_ratio: float | None = None,
+    u: npt.NDArray[np.float64] | None = None,
+    *,
+    youngs_modulus: float | None = None,
 ) -> npt.NDArray[np.float64]:
-    """Element stresses (E,6) Pa in the order xx, yy, zz, yz, xz, xy."""
+    """Element stresses (E,6) Pa in the order xx, yy, zz, yz, xz, xy.
+
+    Every argument is required; ``youngs_modulus`` is the old name of ``young_modulus``."""
 
 def fem_stress_invariants(
     s: npt.NDArray[np.float64],
@@ -260,9 +268,9 @@ class FemTetSolver:
         cls,
         nodes: npt.NDArray[np.float64],
         tets: npt.NDArray[np.int64],
-        youngs_modulus: float,
-        poisson_ratio: float,
-        density: float,
+        young_modulus: float | None = None,
+        poisson_ratio: float | None = None,
+        density: float | None = None,
         dt: float | None = None,
         safety_factor: float = 0.9,
         rayleigh_alpha: float = 0.0,
@@ -270,7 +278,11 @@ class FemTetSolver:
         mass_scaling_dt: float | None = None,
         certified_step: bool = True,
         energy_interval: int = 100,
-    ) -> FemTetSolver: ...
+        *,
+        youngs_modulus: float | None = None,
+    ) -> FemTetSolver:
+        """young_modulus (Pa), poisson_ratio and density (kg/m³) are required;
+        ``youngs_modulus`` is the old name of ``young_modulus``."""
     def set_prescribed(
         self,
         dofs: npt.NDArray[np.int64],
@@ -336,12 +348,16 @@ class FemShellSolver:
         nodes: npt.NDArray[np.float64],
         triangles: npt.NDArray[np.int64],
         thickness: npt.NDArray[np.float64],
-        youngs_modulus: float,
-        poisson_ratio: float,
-        density: float,
+        young_modulus: float | None = None,
+        poisson_ratio: float | None = None,
+        density: float | None = None,
         fixed: npt.NDArray[np.int64] | None = None,
         dt: float | None = None,
-    ) -> FemShellSolver: ...
+        *,
+        youngs_modulus: float | None = None,
+    ) -> FemShellSolver:
+        """young_modulus (Pa), poisson_ratio and density (kg/m³) are required;
+        ``youngs_modulus`` is the old name of ``young_modulus``."""
     def set_initial_velocity(self, v: npt.NDArray[np.float64]) -> None: ...
     def add_gravity(self, g: tuple[float, float, float]) -> None: ...
     def set_contact(

@@ -5,6 +5,7 @@
 
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -256,4 +257,24 @@ pub(crate) fn ids(a: &PyReadonlyArray1<'_, i64>, field: &str, n: usize) -> PyRes
             u32::try_from(x).map_err(|_| invalid(field, &x.to_string(), "integers in [0, 2^32)"))
         })
         .collect()
+}
+
+/// Young's modulus E (Pa) given as `young_modulus` (the documented name) or by its old
+/// name `youngs_modulus` (still accepted as an alias): exactly one of the two.
+pub(crate) fn young_modulus(value: Option<f64>, alias: Option<f64>) -> PyResult<f64> {
+    match (value, alias) {
+        (Some(e), None) | (None, Some(e)) => Ok(e),
+        (Some(_), Some(_)) => Err(PyTypeError::new_err(
+            "give young_modulus or its old name youngs_modulus, not both",
+        )),
+        (None, None) => Err(PyTypeError::new_err(
+            "missing required argument: 'young_modulus' (Pa)",
+        )),
+    }
+}
+
+/// An argument that is required although the signature gives it a default (it follows
+/// `young_modulus`, which has one so that its alias can stand in for it).
+pub(crate) fn required<T>(name: &str, value: Option<T>) -> PyResult<T> {
+    value.ok_or_else(|| PyTypeError::new_err(format!("missing required argument: '{name}'")))
 }

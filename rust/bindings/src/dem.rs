@@ -8,7 +8,7 @@ use numpy::{IntoPyArray, PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
-use demfem::dem::{ContactModel, EffectSet, Material, ParticleInit, Scene, Simulation};
+use demfem::dem::{DemContactLaw, EffectSet, Material, ParticleInit, Scene, Simulation};
 use demfem::geometry::Vec3;
 
 use crate::convert::{
@@ -219,9 +219,9 @@ impl DemSimulation {
         let mut scene = Scene::new(p, mats, ws, effects);
         scene.gravity = Vec3::new(gravity.0, gravity.1, gravity.2);
         scene.model = match (model, linear_stiffness) {
-            ("hertz_mindlin", _) => ContactModel::HertzMindlin,
-            ("hertz_reissner_mindlin", _) => ContactModel::HertzReissnerMindlin,
-            ("linear", Some((kn, kt))) => ContactModel::LinearSpringDashpot {
+            ("hertz_mindlin", _) => DemContactLaw::HertzMindlin,
+            ("hertz_reissner_mindlin", _) => DemContactLaw::HertzReissnerMindlin,
+            ("linear", Some((kn, kt))) => DemContactLaw::LinearSpringDashpot {
                 normal_stiffness: kn,
                 tangential_stiffness: kt,
             },

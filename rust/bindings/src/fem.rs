@@ -15,7 +15,7 @@ use demfem::fem::{
 };
 use demfem::DemfemError;
 
-use crate::convert::{arr3, arr6, idx_arr, rows3, Nodes};
+use crate::convert::{self, arr3, arr6, idx_arr, required, rows3, Nodes};
 use crate::error::{invalid, shape_err, PyDemfemError};
 use crate::fem_contact::{self, PyRigid};
 use crate::run::run_in_chunks;
@@ -182,23 +182,30 @@ fn prescribed_list(
         .collect()
 }
 
-/// Linear static solve K u = f. `fixed_dofs` (k,2): node, component; `fixed_values` (k,) m.
-/// Returns (u (N,3) m, reactions (N,3) N).
+/// Linear static solve K u = f, E = `young_modulus` (Pa; `youngs_modulus` is its old name).
+/// `fixed_dofs` (k,2): node, component; `fixed_values` (k,) m. Every argument but the alias
+/// is required. Returns (u (N,3) m, reactions (N,3) N).
 #[pyfunction]
+#[pyo3(signature = (nodes, tets, young_modulus=None, poisson_ratio=None, loads=None, fixed_dofs=None, fixed_values=None, *, youngs_modulus=None))]
 #[allow(clippy::too_many_arguments)]
 fn fem_solve_static<'py>(
     py: Python<'py>,
     nodes: PyReadonlyArray2<'py, f64>,
     tets: PyReadonlyArray2<'py, i64>,
-    youngs_modulus: f64,
-    poisson_ratio: f64,
-    loads: PyReadonlyArray2<'py, f64>,
-    fixed_dofs: PyReadonlyArray2<'py, i64>,
-    fixed_values: PyReadonlyArray1<'py, f64>,
+    young_modulus: Option<f64>,
+    poisson_ratio: Option<f64>,
+    loads: Option<PyReadonlyArray2<'py, f64>>,
+    fixed_dofs: Option<PyReadonlyArray2<'py, i64>>,
+    fixed_values: Option<PyReadonlyArray1<'py, f64>>,
+    youngs_modulus: Option<f64>,
 ) -> PyResult<(Nodes<'py>, Nodes<'py>)> {
+    let e = convert::young_modulus(young_modulus, youngs_modulus)?;
+    let nu = required("poisson_ratio", poisson_ratio)?;
+    let loads = required("loads", loads)?;
+    let fixed_dofs = required("fixed_dofs", fixed_dofs)?;
+    let fixed_values = required("fixed_values", fixed_values)?;
     let mesh = to_mesh(&nodes, &tets)?;
-    let mat =
-        LinearElastic::new(youngs_modulus, poisson_ratio, 1.0).map_err(PyDemfemError::from)?;
+    let mat = LinearElastic::new(e, nu, 1.0).map_err(PyDemfemError::from)?;
     let f = rows3(&loads, "loads")?;
     let fixed = prescribed_list(&fixed_dofs, &fixed_values)?;
     let sol = py
@@ -207,19 +214,25 @@ fn fem_solve_static<'py>(
     Ok((arr3(py, &sol.displacement)?, arr3(py, &sol.reaction)?))
 }
 
-/// Element stresses (E,6) Pa, order xx, yy, zz, yz, xz, xy, for displacements u (N,3) m.
+/// Element stresses (E,6) Pa, order xx, yy, zz, yz, xz, xy, for displacements u (N,3) m;
+/// E = `young_modulus` (Pa; `youngs_modulus` is its old name). Every argument but the alias
+/// is required.
 #[pyfunction]
+#[pyo3(signature = (nodes, tets, young_modulus=None, poisson_ratio=None, u=None, *, youngs_modulus=None))]
 fn fem_element_stresses<'py>(
     py: Python<'py>,
     nodes: PyReadonlyArray2<'py, f64>,
     tets: PyReadonlyArray2<'py, i64>,
-    youngs_modulus: f64,
-    poisson_ratio: f64,
-    u: PyReadonlyArray2<'py, f64>,
+    young_modulus: Option<f64>,
+    poisson_ratio: Option<f64>,
+    u: Option<PyReadonlyArray2<'py, f64>>,
+    youngs_modulus: Option<f64>,
 ) -> PyResult<Nodes<'py>> {
+    let e = convert::young_modulus(young_modulus, youngs_modulus)?;
+    let nu = required("poisson_ratio", poisson_ratio)?;
+    let u = required("u", u)?;
     let mesh = to_mesh(&nodes, &tets)?;
-    let mat =
-        LinearElastic::new(youngs_modulus, poisson_ratio, 1.0).map_err(PyDemfemError::from)?;
+    let mat = LinearElastic::new(e, nu, 1.0).map_err(PyDemfemError::from)?;
     let u = rows3(&u, "u")?;
     let s = stress::element_stresses(&mesh, &mat, &u).map_err(PyDemfemError::from)?;
     arr6(py, &s)
@@ -259,16 +272,18 @@ struct FemTetSolver {
 
 #[pymethods]
 impl FemTetSolver {
+    /// Tet mesh: nodes (N,3) m, tets (E,4); material `young_modulus` E (Pa; `youngs_modulus`
+    /// is its old name), ν, density (kg/m³), all required; the step and damping settings.
     #[new]
-    #[pyo3(signature = (nodes, tets, youngs_modulus, poisson_ratio, density, dt=None, safety_factor=0.9, rayleigh_alpha=0.0, rayleigh_beta=0.0, mass_scaling_dt=None, certified_step=true, energy_interval=100))]
+    #[pyo3(signature = (nodes, tets, young_modulus=None, poisson_ratio=None, density=None, dt=None, safety_factor=0.9, rayleigh_alpha=0.0, rayleigh_beta=0.0, mass_scaling_dt=None, certified_step=true, energy_interval=100, *, youngs_modulus=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
         nodes: PyReadonlyArray2<'_, f64>,
         tets: PyReadonlyArray2<'_, i64>,
-        youngs_modulus: f64,
-        poisson_ratio: f64,
-        density: f64,
+        young_modulus: Option<f64>,
+        poisson_ratio: Option<f64>,
+        density: Option<f64>,
         dt: Option<f64>,
         safety_factor: f64,
         rayleigh_alpha: f64,
@@ -276,10 +291,13 @@ impl FemTetSolver {
         mass_scaling_dt: Option<f64>,
         certified_step: bool,
         energy_interval: usize,
+        youngs_modulus: Option<f64>,
     ) -> PyResult<Self> {
+        let e = convert::young_modulus(young_modulus, youngs_modulus)?;
+        let nu = required("poisson_ratio", poisson_ratio)?;
+        let density = required("density", density)?;
         let mesh = to_mesh(&nodes, &tets)?;
-        let material = LinearElastic::new(youngs_modulus, poisson_ratio, density)
-            .map_err(PyDemfemError::from)?;
+        let material = LinearElastic::new(e, nu, density).map_err(PyDemfemError::from)?;
         let mut cfg = ExplicitConfig::new(material);
         cfg.dt = dt;
         cfg.safety_factor = safety_factor;

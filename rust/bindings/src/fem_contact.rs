@@ -1,12 +1,12 @@
 //! Conversion of the Python contact description (numpy arrays and tuples) into the core's
-//! [`ContactModel`], and of its outputs back into numpy arrays and dicts.
+//! [`FemContact`], and of its outputs back into numpy arrays and dicts.
 
 use numpy::{PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use demfem::fem::contact::{
-    ContactModel, ContactSettings, NoTensionSpring, RigidShape, RigidSurface,
+    ContactSettings, FemContact, NoTensionSpring, RigidShape, RigidSurface,
 };
 use demfem::fem::{LinearElastic, TetMesh, TriMesh};
 use demfem::DemfemError;
@@ -85,11 +85,11 @@ pub fn build(
     spring_anchors: Option<PyReadonlyArray2<'_, f64>>,
     spring_stiffness: Option<PyReadonlyArray1<'_, f64>>,
     spring_rest_length: Option<PyReadonlyArray1<'_, f64>>,
-) -> PyResult<ContactModel> {
+) -> PyResult<FemContact> {
     let n = mesh.nodes.len();
     let body = ids(&body_of_node, "body_of_node", n)?;
     let region = ids(&region_of_node, "region_of_node", n)?;
-    let c = ContactModel::new(mesh, &body, &region, material, settings).map_err(err)?;
+    let c = FemContact::new(mesh, &body, &region, material, settings).map_err(err)?;
     extras(
         c,
         rigid_surfaces,
@@ -114,11 +114,11 @@ pub fn build_shell(
     spring_anchors: Option<PyReadonlyArray2<'_, f64>>,
     spring_stiffness: Option<PyReadonlyArray1<'_, f64>>,
     spring_rest_length: Option<PyReadonlyArray1<'_, f64>>,
-) -> PyResult<ContactModel> {
+) -> PyResult<FemContact> {
     let n = mesh.nodes.len();
     let body = ids(&body_of_node, "body_of_node", n)?;
     let region = ids(&region_of_node, "region_of_node", n)?;
-    let c = ContactModel::new_shell(mesh, &body, &region, material, settings).map_err(err)?;
+    let c = FemContact::new_shell(mesh, &body, &region, material, settings).map_err(err)?;
     extras(
         c,
         rigid_surfaces,
@@ -131,13 +131,13 @@ pub fn build_shell(
 
 /// Add the rigid surfaces and springs to a contact model.
 fn extras(
-    mut c: ContactModel,
+    mut c: FemContact,
     rigid_surfaces: Vec<PyRigid>,
     spring_nodes: Option<PyReadonlyArray1<'_, i64>>,
     spring_anchors: Option<PyReadonlyArray2<'_, f64>>,
     spring_stiffness: Option<PyReadonlyArray1<'_, f64>>,
     spring_rest_length: Option<PyReadonlyArray1<'_, f64>>,
-) -> PyResult<ContactModel> {
+) -> PyResult<FemContact> {
     for r in &rigid_surfaces {
         c.add_rigid(rigid(r)?).map_err(err)?;
     }
@@ -192,7 +192,7 @@ fn extras(
 }
 
 /// The contact's counters as a dict.
-pub fn info<'py>(py: Python<'py>, c: &ContactModel, dt_free: f64) -> PyResult<Bound<'py, PyDict>> {
+pub fn info<'py>(py: Python<'py>, c: &FemContact, dt_free: f64) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     let e = c.energy();
     d.set_item("elastic_energy", e.elastic)?;

@@ -11,7 +11,7 @@ use demfem::fem::shell::{ShellExplicit, ShellModel};
 use demfem::fem::{LinearElastic, TriMesh};
 use demfem::DemfemError;
 
-use crate::convert::{arr3, rows3, Nodes};
+use crate::convert::{self, arr3, required, rows3, Nodes};
 use crate::error::{core_err as e, shape_err};
 use crate::fem_contact::{self, PyRigid};
 use crate::run::run_in_chunks;
@@ -26,21 +26,26 @@ pub struct FemShellSolver {
 #[pymethods]
 impl FemShellSolver {
     /// Shell mesh: mid-surface nodes (N,3) m, triangles (T,3), thickness (T,) m; material
-    /// E (Pa), ν, density (kg/m³); fixed dofs as (node, dof 0–5) pairs (K,2); a fixed step
+    /// `young_modulus` E (Pa; `youngs_modulus` is its old name), ν, density (kg/m³), all
+    /// required; fixed dofs as (node, dof 0–5) pairs (K,2); a fixed step
     /// dt (s) or None for 0.9 × the certified bound.
     #[new]
-    #[pyo3(signature = (nodes, triangles, thickness, youngs_modulus, poisson_ratio, density, fixed=None, dt=None))]
+    #[pyo3(signature = (nodes, triangles, thickness, young_modulus=None, poisson_ratio=None, density=None, fixed=None, dt=None, *, youngs_modulus=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         nodes: PyReadonlyArray2<'_, f64>,
         triangles: PyReadonlyArray2<'_, i64>,
         thickness: PyReadonlyArray1<'_, f64>,
-        youngs_modulus: f64,
-        poisson_ratio: f64,
-        density: f64,
+        young_modulus: Option<f64>,
+        poisson_ratio: Option<f64>,
+        density: Option<f64>,
         fixed: Option<PyReadonlyArray2<'_, i64>>,
         dt: Option<f64>,
+        youngs_modulus: Option<f64>,
     ) -> PyResult<Self> {
+        let young_modulus = convert::young_modulus(young_modulus, youngs_modulus)?;
+        let poisson_ratio = required("poisson_ratio", poisson_ratio)?;
+        let density = required("density", density)?;
         let nodes = rows3(&nodes, "nodes")?;
         let t = triangles.as_array();
         if t.ncols() != 3 {
@@ -70,7 +75,7 @@ impl FemShellSolver {
                 }));
             }
         }
-        let material = LinearElastic::new(youngs_modulus, poisson_ratio, density).map_err(e)?;
+        let material = LinearElastic::new(young_modulus, poisson_ratio, density).map_err(e)?;
         let mut fx = Vec::new();
         if let Some(f) = fixed {
             let f = f.as_array();

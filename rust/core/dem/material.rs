@@ -81,7 +81,7 @@ impl Material {
 
 /// Which normal law (and matching tangential spring) the scene uses for every pair.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum ContactModel {
+pub enum DemContactLaw {
     /// Hertz normal force F = 4/3 E* √R* δ^{3/2}, Mindlin tangential spring k_t = 8 G* √(R* δ),
     /// Tsuji restitution damping.
     HertzMindlin,
@@ -99,10 +99,10 @@ pub enum ContactModel {
     },
 }
 
-impl ContactModel {
+impl DemContactLaw {
     /// Validate the model's own parameters.
     pub fn validate(&self) -> Result<()> {
-        if let ContactModel::LinearSpringDashpot {
+        if let DemContactLaw::LinearSpringDashpot {
             normal_stiffness,
             tangential_stiffness,
         } = *self
@@ -115,7 +115,7 @@ impl ContactModel {
 
     /// Whether the normal law derives from E (Hertz-type), which brings in the Rayleigh limit.
     pub fn is_hertzian(&self) -> bool {
-        !matches!(self, ContactModel::LinearSpringDashpot { .. })
+        !matches!(self, DemContactLaw::LinearSpringDashpot { .. })
     }
 }
 
@@ -146,7 +146,7 @@ pub struct PairLaw {
 
 impl PairLaw {
     /// Derive the pair parameters of materials `a` and `b` under `model`.
-    pub fn new(a: &Material, b: &Material, model: ContactModel, clamp: ForceClamp) -> Result<Self> {
+    pub fn new(a: &Material, b: &Material, model: DemContactLaw, clamp: ForceClamp) -> Result<Self> {
         let restitution = a.restitution.min(b.restitution);
         let zeta = if model.is_hertzian() {
             contact::tsuji_damping_for_restitution(restitution, clamp)?
@@ -158,7 +158,7 @@ impl PairLaw {
 
     /// As [`PairLaw::new`] with the Tsuji parameter ζ already known (it costs a bisection
     /// over an ODE solve, so a scene computes it once per distinct restitution).
-    pub fn with_zeta(a: &Material, b: &Material, model: ContactModel, zeta: f64) -> Result<Self> {
+    pub fn with_zeta(a: &Material, b: &Material, model: DemContactLaw, zeta: f64) -> Result<Self> {
         let e_star = contact::effective_modulus(
             a.young_modulus,
             a.poisson_ratio,
@@ -177,10 +177,10 @@ impl PairLaw {
         };
         let restitution = a.restitution.min(b.restitution);
         let (zeta, linear_damping, tangential_damping_ratio) = match model {
-            ContactModel::HertzMindlin | ContactModel::HertzReissnerMindlin => {
+            DemContactLaw::HertzMindlin | DemContactLaw::HertzReissnerMindlin => {
                 (zeta, 0.0, (4.0 * g_star / e_star).sqrt())
             }
-            ContactModel::LinearSpringDashpot {
+            DemContactLaw::LinearSpringDashpot {
                 normal_stiffness,
                 tangential_stiffness,
             } => {

@@ -25,7 +25,7 @@ pub mod table;
 
 pub use checkpoint::CHECKPOINT_VERSION;
 pub use effects::{Effect, EffectSet};
-pub use material::{ContactModel, Material, PairLaw};
+pub use material::{DemContactLaw, Material, PairLaw};
 pub use record::{ContactEvent, ContactOnset, ContactRecord, Frame, Partner};
 pub use scene::{ParticleInit, Scene};
 pub use simulation::{stable_time_step, Simulation, StableStep, PARALLEL_MIN_PARTICLES};

@@ -2,7 +2,7 @@
 //! numerical settings), with the checks that refuse inconsistent input.
 
 use crate::dem::effects::{Effect, EffectSet};
-use crate::dem::material::{ContactModel, Material};
+use crate::dem::material::{DemContactLaw, Material};
 use crate::error::{check_non_negative, check_positive, DemfemError, Result};
 use crate::geometry::{Vec3, Wall};
 
@@ -62,7 +62,7 @@ pub struct Scene {
     /// Gravitational acceleration, m/s² (used only with the `gravity` effect).
     pub gravity: Vec3,
     /// Contact law of every pair.
-    pub model: ContactModel,
+    pub model: DemContactLaw,
     /// Clamp the damped normal force at ≥ 0 (no attraction); the Tsuji ζ is solved for the
     /// chosen clamping, so the realised restitution is e either way.
     pub clamp_normal_force: bool,
@@ -108,7 +108,7 @@ impl Scene {
             walls,
             effects,
             gravity: Vec3::new(0.0, 0.0, -9.81),
-            model: ContactModel::HertzMindlin,
+            model: DemContactLaw::HertzMindlin,
             clamp_normal_force: true,
             time_step: None,
             time_step_safety: 0.2,

@@ -66,7 +66,7 @@
 //! - `stable`: the stable time step.
 
 use crate::dem::effects::{Effect, EffectSet};
-use crate::dem::material::{ContactModel, PairLaw};
+use crate::dem::material::{DemContactLaw, PairLaw};
 use crate::dem::neighbor::CellGrid;
 use crate::dem::record::{ContactEvent, ContactOnset, Frame};
 use crate::geometry::{Vec3, Wall};
@@ -148,7 +148,7 @@ pub struct Simulation {
     pub(crate) walls: Vec<Wall>,
     pub(crate) laws: Vec<PairLaw>,
     pub(crate) n_materials: usize,
-    pub(crate) model: ContactModel,
+    pub(crate) model: DemContactLaw,
     pub(crate) effects: EffectSet,
     pub(crate) gravity: Vec3,
     pub(crate) clamp: bool,

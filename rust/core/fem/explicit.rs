@@ -27,7 +27,7 @@ use rayon::prelude::*;
 
 use crate::error::{check_non_negative, check_open, check_positive, DemfemError, Result};
 use crate::fem::assembly::lumped_mass;
-use crate::fem::contact::{ContactEnergy, ContactModel};
+use crate::fem::contact::{ContactEnergy, FemContact};
 use crate::fem::material::LinearElastic;
 use crate::fem::mesh::{tet_quality, TetMesh};
 use crate::fem::reduce::{det_sum, NODE_CHUNK};
@@ -218,7 +218,7 @@ pub struct ExplicitSolver {
     steps: u64,
     energy: EnergyReport,
     history: Vec<EnergyReport>,
-    contact: Option<ContactModel>,
+    contact: Option<FemContact>,
     f_contact: Vec<[f64; 3]>,
     dt_limit_without_contact: f64,
 }
@@ -471,7 +471,7 @@ impl ExplicitSolver {
     /// with the contact's eigenvalue allowance added to the bound (Weyl: λ_max(A + B) ≤
     /// λ_max(A) + λ_max(B)); an automatic step is reduced to fit, a fixed `dt` above the new
     /// limit is refused. Bodies overlapping at the start are refused.
-    pub fn set_contact(&mut self, mut contact: ContactModel) -> Result<()> {
+    pub fn set_contact(&mut self, mut contact: FemContact) -> Result<()> {
         self.require_start("contact")?;
         let allowance = contact.eigenvalue_allowance(&self.mass)?;
         contact.check_initial_overlap(&self.u)?;
@@ -502,7 +502,7 @@ impl ExplicitSolver {
     }
 
     /// The attached contact model.
-    pub fn contact(&self) -> Option<&ContactModel> {
+    pub fn contact(&self) -> Option<&FemContact> {
         self.contact.as_ref()
     }
     /// Contact energies (zero without contact).

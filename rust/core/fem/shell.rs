@@ -49,7 +49,7 @@ impl ShellModel {
 
     /// Global stiffness triplets (both triangles; duplicates to be summed).
     pub fn stiffness_triplets(&self) -> Vec<(usize, usize, f64)> {
-        let (e, nu) = (self.material.youngs_modulus, self.material.poisson_ratio);
+        let (e, nu) = (self.material.young_modulus, self.material.poisson_ratio);
         let mut out = Vec::with_capacity(self.elements.len() * 324);
         for (t, el) in self.mesh.triangles.iter().zip(&self.elements) {
             let k = el.global_stiffness(e, nu);
@@ -107,7 +107,7 @@ impl ShellModel {
                 detail: format!("expected {} dofs", self.n_dofs()),
             });
         }
-        let (e, nu) = (self.material.youngs_modulus, self.material.poisson_ratio);
+        let (e, nu) = (self.material.young_modulus, self.material.poisson_ratio);
         Ok(self
             .mesh
             .triangles
@@ -154,7 +154,7 @@ pub struct ShellExplicit {
     dt_requested: Option<f64>,
     lam_max: f64,
     dt_limit_without_contact: f64,
-    contact: Option<crate::fem::contact::ContactModel>,
+    contact: Option<crate::fem::contact::FemContact>,
     f_contact: Vec<[f64; 3]>,
     u3: Vec<[f64; 3]>,
     v3: Vec<[f64; 3]>,
@@ -171,7 +171,7 @@ impl ShellExplicit {
         use nalgebra::SymmetricEigen;
         let nn = model.mesh.nodes.len();
         let (e, nu, rho) = (
-            model.material.youngs_modulus,
+            model.material.young_modulus,
             model.material.poisson_ratio,
             model.material.density,
         );

@@ -45,7 +45,7 @@ impl ContactMaterial {
 
 /// Normal and tangential contact model shared by all contacts of a scene.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ContactModel {
+pub struct RigidContactLaw {
     /// Effective modulus body–body, Pa.
     pub e_star_body_body: f64,
     /// Effective modulus body–plane, Pa.
@@ -58,7 +58,7 @@ pub struct ContactModel {
     pub tangential_stiffness_ratio: f64,
 }
 
-impl ContactModel {
+impl RigidContactLaw {
     /// Build from the body and plane materials, the restitution e ∈ (0, 1] of a Hertz impact
     /// and the friction coefficient μ ≥ 0.
     pub fn new(
@@ -119,7 +119,7 @@ impl ContactModel {
         .map(|(force, _)| force)
     }
 
-    /// As [`ContactModel::force`], with the elastic energy stored in the contact after the
+    /// As [`RigidContactLaw::force`], with the elastic energy stored in the contact after the
     /// update (J): the Hertz potential 2/5 k_H δ^{5/2} plus the Mindlin spring ½ k_t |ξ|².
     #[inline]
     pub fn force_and_energy(
@@ -196,7 +196,7 @@ mod tests {
 
     #[test]
     fn static_normal_force_is_hertz() {
-        let model = ContactModel::new(
+        let model = RigidContactLaw::new(
             ContactMaterial::PAPER_GLASS,
             ContactMaterial::PAPER_GLASS,
             1.0,
@@ -219,7 +219,7 @@ mod tests {
 
     #[test]
     fn friction_is_capped_by_coulomb_and_sticks_below_it() {
-        let model = ContactModel::new(
+        let model = RigidContactLaw::new(
             ContactMaterial::PAPER_GLASS,
             ContactMaterial::PAPER_GLASS,
             1.0,

@@ -23,7 +23,7 @@ pub mod shape;
 
 pub use body::{RigidBodies, RigidBodyInit};
 pub use collision::{BodyPose, ContactPoint, Plane, PolygonWall};
-pub use forces::{ContactMaterial, ContactModel};
+pub use forces::{ContactMaterial, RigidContactLaw};
 pub use scene::{RigidOnset, RigidScene, RigidSceneConfig, RigidWall};
 pub use revolution::RevolutionShape;
 pub use shape::{

@@ -32,7 +32,7 @@ use super::body::{RigidBodies, RigidBodyInit};
 use super::collision::{
     BodyPose, ClumpPairScratch, ContactPoint, ExactContactCache, Plane, PolygonWall,
 };
-use super::forces::{ContactMaterial, ContactModel};
+use super::forces::{ContactMaterial, RigidContactLaw};
 use super::shape::{MassProperties, RigidShape};
 use crate::contact::{effective_mass, effective_radius, hertz_contact_duration, hertz_stiffness};
 use crate::error::{check_positive, DemfemError, Result};
@@ -210,7 +210,7 @@ pub struct RigidScene {
     body_shape: Vec<usize>,
     planes: Vec<Plane>,
     gravity: Vector3<f64>,
-    model: ContactModel,
+    model: RigidContactLaw,
     max_expected_speed: f64,
     requested_time_step: Option<f64>,
     time_step: f64,
@@ -273,7 +273,7 @@ impl RigidScene {
                 Some((point, normal / length))
             }
         };
-        let model = ContactModel::new(
+        let model = RigidContactLaw::new(
             config.body_material,
             config.plane_material,
             config.restitution,

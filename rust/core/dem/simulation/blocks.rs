@@ -7,7 +7,7 @@
 use super::pair::PairLists;
 use super::state::{Flips, PairContact, WallContact, WallDetail, WallOut};
 use super::{Simulation, NO_WALL, PAIR_CHUNK};
-use crate::dem::material::ContactModel;
+use crate::dem::material::DemContactLaw;
 use crate::geometry::WallShape;
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -278,7 +278,7 @@ impl Simulation {
     fn particle_costs(&self) -> Vec<u64> {
         let stride = self.wall_stride.max(1);
         let contact_cost = match self.model {
-            ContactModel::HertzReissnerMindlin => CONTACT_COST_REISSNER,
+            DemContactLaw::HertzReissnerMindlin => CONTACT_COST_REISSNER,
             _ => CONTACT_COST,
         };
         let mut cost = vec![PARTICLE_COST; self.position.len()];

@@ -5,7 +5,7 @@
 use super::on;
 use crate::contact;
 use crate::dem::effects::{Effect, EffectSet};
-use crate::dem::material::{ContactModel, PairLaw};
+use crate::dem::material::{DemContactLaw, PairLaw};
 use crate::geometry::Vec3;
 
 /// Constants of one contact (a pair or a particle–wall slot) derived from the pair law, the
@@ -57,7 +57,7 @@ pub(crate) enum LawKind {
 
 impl ContactConst {
     pub(super) fn new(
-        model: ContactModel,
+        model: DemContactLaw,
         laws: &[PairLaw],
         law: usize,
         r_star: f64,
@@ -77,9 +77,9 @@ impl ContactConst {
             kind: LawKind::Hertz,
         };
         match model {
-            ContactModel::HertzMindlin => base,
-            ContactModel::HertzReissnerMindlin if l.shell_stiffness.is_infinite() => base,
-            ContactModel::HertzReissnerMindlin => {
+            DemContactLaw::HertzMindlin => base,
+            DemContactLaw::HertzReissnerMindlin if l.shell_stiffness.is_infinite() => base,
+            DemContactLaw::HertzReissnerMindlin => {
                 // the law's constants were validated (E*, R* > 0, k_R finite > 0)
                 let k_h = base.f_el;
                 let k_r = l.shell_stiffness;
@@ -93,7 +93,7 @@ impl ContactConst {
                     ..base
                 }
             }
-            ContactModel::LinearSpringDashpot {
+            DemContactLaw::LinearSpringDashpot {
                 normal_stiffness,
                 tangential_stiffness,
             } => ContactConst {
@@ -112,7 +112,7 @@ impl ContactConst {
 #[inline(always)]
 pub(super) fn law_at<const E: u16>(
     k: &ContactConst,
-    _model: ContactModel,
+    _model: DemContactLaw,
     _laws: &[PairLaw],
     effects: EffectSet,
     overlap: f64,

@@ -7,7 +7,7 @@ use super::law::{law_at, tangential_force, ContactConst};
 use super::on;
 use super::state::{Flips, PairContact, PairDetail, PairOut};
 use crate::dem::effects::{Effect, EffectSet};
-use crate::dem::material::{ContactModel, PairLaw};
+use crate::dem::material::{DemContactLaw, PairLaw};
 use crate::geometry::Vec3;
 
 /// Read-only context of the pair kernel; the wall kernels share it (see [`WallCtx`]).
@@ -23,7 +23,7 @@ pub(super) struct PairCtx<'a> {
     pub(super) radius: &'a [f64],
     pub(super) inertia: &'a [f64],
     pub(super) laws: &'a [PairLaw],
-    pub(super) model: ContactModel,
+    pub(super) model: DemContactLaw,
     pub(super) effects: EffectSet,
     pub(super) clamp: bool,
     pub(super) dt: f64,

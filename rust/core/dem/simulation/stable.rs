@@ -2,7 +2,7 @@
 
 use crate::contact;
 use crate::dem::effects::Effect;
-use crate::dem::material::{ContactModel, PairLaw};
+use crate::dem::material::{DemContactLaw, PairLaw};
 use crate::dem::scene::Scene;
 use crate::error::Result;
 
@@ -79,7 +79,7 @@ pub fn stable_time_step(scene: &Scene, mass: &[f64]) -> Result<StableStep> {
         for (other, m_star, r_star, what) in partners {
             let law = PairLaw::with_zeta(mat, &scene.materials[other], scene.model, 0.0)?;
             let (k_n, k_t) = match scene.model {
-                ContactModel::LinearSpringDashpot {
+                DemContactLaw::LinearSpringDashpot {
                     normal_stiffness,
                     tangential_stiffness,
                 } => (normal_stiffness, tangential_stiffness),

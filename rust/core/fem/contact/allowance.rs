@@ -1,6 +1,6 @@
 //! The contact's share of the stable step. With mass-normalised coordinates, a spring k
 //! between a node and a face adds at most k (1/√m_s + 1/√m_f,min)² to a Gershgorin row;
-//! [`ContactModel::eigenvalue_allowance`] is that bound for the stiffest face times
+//! [`FemContact::eigenvalue_allowance`] is that bound for the stiffest face times
 //! [`super::ContactSettings::contacts_per_node`], plus the rigid and spring terms, certified
 //! into the solver's step. Every step the Gershgorin bound of the springs actually active is
 //! checked against it, so a run never goes past its certified step silently. Eigenvalues
@@ -11,9 +11,9 @@ use rayon::prelude::*;
 use crate::error::{DemfemError, Result};
 
 use super::hits::Hit;
-use super::{ContactModel, NODE_CHUNK};
+use super::{FemContact, NODE_CHUNK};
 
-impl ContactModel {
+impl FemContact {
     /// Largest Gershgorin bound of the active contact springs seen so far, 1/s².
     pub fn max_contact_eigenvalue(&self) -> f64 {
         self.max_gershgorin

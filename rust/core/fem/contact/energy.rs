@@ -5,7 +5,7 @@
 
 use rayon::prelude::*;
 
-use super::{ContactModel, NODE_CHUNK};
+use super::{FemContact, NODE_CHUNK};
 
 /// Energies of the contact model, J.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -32,7 +32,7 @@ impl ContactEnergy {
     }
 }
 
-impl ContactModel {
+impl FemContact {
     /// Add the work of the contact forces `force` (N per node) over the step that reached
     /// the displacement `u` (m), summed per fixed chunk (other nodes carry no force and add
     /// nothing); remember `u` and `force` for the next step.

@@ -8,9 +8,9 @@ use rayon::prelude::*;
 
 use super::hits::Hit;
 use super::vec3::{add, norm, scale, sub};
-use super::{ContactModel, NODE_CHUNK};
+use super::{FemContact, NODE_CHUNK};
 
-impl ContactModel {
+impl FemContact {
     /// Apply `hits` in their order: `force` (N per node) is cleared and gets the contact
     /// forces. Returns the face each surface node touched (`u32::MAX` for none) and the
     /// elastic energy stored in the contact springs, J.

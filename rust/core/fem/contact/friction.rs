@@ -38,7 +38,7 @@ pub(super) fn friction_update(
         // the solver uses for work (mean force times the tangential travel (old − trial)/k),
         // less the change of the spring's energy: the bookkeeping closes step by step. For
         // steady sliding (old = ft) it is μ f_n times the slip. A moving rigid surface's
-        // work is counted with the new force alone (`ContactModel::compute`), so half the
+        // work is counted with the new force alone (`FemContact::compute`), so half the
         // change of force times its travel v_s Δt closes the step there.
         let work = 0.5 * dot(add(old, ft), sub(old, trial)) / k;
         let stored = 0.5 * (cap * cap - dot(old, old)) / k;

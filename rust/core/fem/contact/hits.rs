@@ -1,6 +1,6 @@
 //! The contacts of one step (narrow phase and friction): every surface node against the
-//! faces of the other bodies ([`ContactModel::face_hit`]) and against every rigid surface
-//! ([`ContactModel::rigid_hits`], in `rigid`), in parallel over fixed chunks of surface
+//! faces of the other bodies ([`FemContact::face_hit`]) and against every rigid surface
+//! ([`FemContact::rigid_hits`], in `rigid`), in parallel over fixed chunks of surface
 //! nodes and gathered in node order, so the list is the same for any number of threads.
 //! Forces in N, lengths in m, energies in J.
 
@@ -9,7 +9,7 @@ use rayon::prelude::*;
 use super::friction::friction_update;
 use super::surface::SurfaceFace;
 use super::vec3::{add, dot, scale, sub};
-use super::{ContactModel, NODE_CHUNK, RECENT_STEPS};
+use super::{FemContact, NODE_CHUNK, RECENT_STEPS};
 
 /// One contact found in a step.
 #[derive(Debug, Clone, Copy)]
@@ -23,7 +23,7 @@ pub(super) struct Hit {
     pub(super) tangential_force: [f64; 3],
     pub(super) stiffness: f64,
     pub(super) penetration: f64,
-    /// Depth subtracted from `penetration` in the force (see `ContactModel::offset`), m.
+    /// Depth subtracted from `penetration` in the force (see `FemContact::offset`), m.
     pub(super) offset: f64,
     /// Side of a shell face (±1; 1 for solids and rigid surfaces).
     pub(super) side: f64,
@@ -32,7 +32,7 @@ pub(super) struct Hit {
     pub(super) rigid_work: f64,
 }
 
-impl ContactModel {
+impl FemContact {
     /// The contacts of this step at node velocities `v` (m/s), time `t` (s) and step `dt`
     /// (s): for each surface node in order, its contact with a face of another body (if
     /// any), then its contacts with the rigid surfaces in their order.

@@ -12,7 +12,7 @@
 //! forces sum to zero (linear momentum is conserved to round-off). Against a rigid surface
 //! a node gets F = k_node d with k_node = Σ k_f/3 over its faces.
 //!
-//! **Shells.** [`ContactModel::new_shell`] builds the model on a shell mesh: every triangle
+//! **Shells.** [`FemContact::new_shell`] builds the model on a shell mesh: every triangle
 //! is a two-sided face, its contact surfaces half its thickness from the mid-surface, and
 //! the gap of a node is its signed distance less half its own and half the face's
 //! thickness, on the side it met the face (see `narrow`); k_f = s·E·t (see
@@ -34,7 +34,7 @@
 //!
 //! **Stable step.** The contact springs stiffen the system. With mass-normalised
 //! coordinates, a spring k between a node and a face adds at most k (1/√m_s + 1/√m_f,min)²
-//! to a Gershgorin row; [`ContactModel::eigenvalue_allowance`] is that bound for the stiffest
+//! to a Gershgorin row; [`FemContact::eigenvalue_allowance`] is that bound for the stiffest
 //! face times [`ContactSettings::contacts_per_node`], plus the rigid and spring terms. The
 //! solver certifies its step for λ_K + allowance, and every step checks the Gershgorin
 //! bound of the springs actually active against the allowance: a run never goes past its
@@ -47,7 +47,7 @@
 //! `output_interval` steps.
 
 //!
-//! **Layout.** One step ([`ContactModel::compute`]) runs, in this order: the broad phase
+//! **Layout.** One step ([`FemContact::compute`]) runs, in this order: the broad phase
 //! (`broad_phase`) and the face geometry (`narrow`); the contacts of the step, narrow phase
 //! and friction against bodies (`hits`, `narrow`, `friction`) and rigid surfaces (`rigid`);
 //! their forces and the contact memory (`forces`); the step allowance check (`allowance`);
@@ -143,7 +143,7 @@ impl ContactSettings {
 
 /// Contact between the bodies of one mesh and with rigid surfaces, plus ghost springs.
 #[derive(Debug, Clone)]
-pub struct ContactModel {
+pub struct FemContact {
     settings: ContactSettings,
     surface: Surface,
     broad: BroadPhase,
@@ -189,7 +189,7 @@ pub struct ContactModel {
     max_gershgorin: f64,
 }
 
-impl ContactModel {
+impl FemContact {
     /// Contact among the bodies of `mesh`: `body_of_node[i]` numbers the body of node i
     /// (0, 1, …), `region_of_node[i]` its output region (0, 1, …; e.g. top and bottom of a
     /// cartridge). `material` gives the bulk modulus of the penalty.
@@ -210,7 +210,7 @@ impl ContactModel {
             });
         }
         let nu = material.poisson_ratio;
-        let bulk = material.youngs_modulus / (3.0 * (1.0 - 2.0 * nu));
+        let bulk = material.young_modulus / (3.0 * (1.0 - 2.0 * nu));
         let surface = Surface::new(mesh, body_of_node, bulk, settings.penalty_scale)?;
         Self::from_surface(surface, &mesh.nodes, body_of_node, region_of_node, settings)
     }

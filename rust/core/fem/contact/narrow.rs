@@ -16,7 +16,7 @@
 use rayon::prelude::*;
 
 use super::vec3::{add, cross, dot, norm, scale, sub};
-use super::{ContactModel, RECENT_STEPS};
+use super::{FemContact, RECENT_STEPS};
 
 /// Faces per parallel work item of the per-step face geometry.
 const FACE_CHUNK: usize = 1024;
@@ -82,7 +82,7 @@ pub(super) struct FaceGeom {
 }
 use crate::error::DemfemError;
 
-impl ContactModel {
+impl FemContact {
     /// Unit normal of face `f` now.
     pub(super) fn face_unit_normal(&self, f: usize) -> [f64; 3] {
         let face = &self.surface.faces[f];
@@ -287,14 +287,14 @@ impl ContactModel {
     }
 }
 
-impl ContactModel {
+impl FemContact {
     /// Whether the surface is a shell's (two-sided faces).
     pub fn is_shell(&self) -> bool {
         self.surface.faces.iter().any(|f| f.half_thickness > 0.0)
     }
 }
 
-impl ContactModel {
+impl FemContact {
     /// Keep a failure for a node that was on a face and lost it by going too deep: behind a
     /// solid face by more than half the element's height, or across a shell face's
     /// mid-surface by its reach (the contact ran away).

@@ -6,7 +6,7 @@
 
 use super::hits::Hit;
 use super::vec3::{add, norm, scale};
-use super::ContactModel;
+use super::FemContact;
 
 /// Contact output of one channel at one sample.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -26,7 +26,7 @@ fn pair_index(a: usize, b: usize, parties: usize) -> usize {
     a * parties - a * (a + 1) / 2 + (b - a - 1)
 }
 
-impl ContactModel {
+impl FemContact {
     /// Number of parties (bodies then rigid surfaces).
     pub fn parties(&self) -> usize {
         self.n_bodies + self.rigid.len()

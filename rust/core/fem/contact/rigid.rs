@@ -1,7 +1,7 @@
 //! Rigid surfaces the FEM bodies can touch: a plane with a surface velocity (the belt),
 //! a sphere and an infinite cylinder (for verification), each with its own Coulomb
 //! friction coefficient. A rigid surface is a party of the contact output like a body.
-//! [`ContactModel::rigid_hits`] finds a surface node's contacts with them: F = k_node d
+//! [`FemContact::rigid_hits`] finds a surface node's contacts with them: F = k_node d
 //! along the surface's normal, k_node = Σ k_f/3 over the node's faces, met half the node's
 //! thickness early on a shell, with the stick spring against the surface's material.
 
@@ -10,7 +10,7 @@ use crate::error::{check_non_negative, check_positive, DemfemError, Result};
 use super::friction::friction_update;
 use super::hits::Hit;
 use super::vec3::{add, dot, norm, scale, sub};
-use super::ContactModel;
+use super::FemContact;
 
 /// The shape of a rigid surface.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -187,7 +187,7 @@ impl RigidSurface {
     }
 }
 
-impl ContactModel {
+impl FemContact {
     /// The contacts of surface node `k` with the rigid surfaces (in their order), with
     /// friction and the power the moving surface puts into the body, appended to `out`;
     /// node velocities `v` (m/s), time `t` (s), step `dt` (s).

@@ -21,15 +21,15 @@ use super::vec3::{cross, norm, sub};
 
 impl Surface {
     /// The two-sided surface of shell mesh `mesh`: `body_of_node[i]` names the body of node
-    /// i (every triangle in one body); `youngs_modulus` E (Pa) and `penalty_scale` s give the
+    /// i (every triangle in one body); `young_modulus` E (Pa) and `penalty_scale` s give the
     /// face stiffnesses s·E·t.
     pub fn from_shell(
         mesh: &TriMesh,
         body_of_node: &[u32],
-        youngs_modulus: f64,
+        young_modulus: f64,
         penalty_scale: f64,
     ) -> Result<Self> {
-        check_positive("youngs_modulus", youngs_modulus)?;
+        check_positive("young_modulus", young_modulus)?;
         check_positive("penalty_scale", penalty_scale)?;
         for (e, &t) in mesh.thickness.iter().enumerate() {
             if !(t > 0.0) || !t.is_finite() {
@@ -64,7 +64,7 @@ impl Surface {
                 nodes: *tri,
                 element: e,
                 body: b,
-                stiffness: penalty_scale * youngs_modulus * t,
+                stiffness: penalty_scale * young_modulus * t,
                 // The reach of the face: its own half thickness plus that of the thickest
                 // node that can meet it, on either side (the broad phase inflates by it).
                 depth: 0.5 * (t + t_max),
@@ -76,7 +76,7 @@ impl Surface {
     }
 }
 
-impl super::ContactModel {
+impl super::FemContact {
     /// Contact among the shell bodies of `mesh` (two-sided faces offset by half the
     /// thickness, penalty s·E·t): `body_of_node[i]` numbers the body of node i (0, 1, …),
     /// `region_of_node[i]` its output region. `material` gives E.
@@ -99,7 +99,7 @@ impl super::ContactModel {
         let surface = Surface::from_shell(
             mesh,
             body_of_node,
-            material.youngs_modulus,
+            material.young_modulus,
             settings.penalty_scale,
         )?;
         Self::from_surface(surface, &mesh.nodes, body_of_node, region_of_node, settings)

@@ -5,7 +5,7 @@
 use crate::error::{check_positive, DemfemError, Result};
 
 use super::vec3::{add, norm, scale, sub};
-use super::ContactModel;
+use super::FemContact;
 
 /// One no-tension spring.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -56,7 +56,7 @@ impl NoTensionSpring {
     }
 }
 
-impl ContactModel {
+impl FemContact {
     /// Add the forces of the no-tension springs into `force` (N per node), and, when
     /// `check`, their stiffness into the Gershgorin bounds; returns their stored energy, J.
     pub(super) fn spring_forces(&mut self, force: &mut [[f64; 3]], check: bool) -> f64 {

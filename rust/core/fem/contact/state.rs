@@ -5,9 +5,9 @@
 use crate::error::{DemfemError, Result};
 use crate::fem::state_io::{StateReader, StateWriter};
 
-use super::{ChannelSample, ContactEnergy, ContactModel};
+use super::{ChannelSample, ContactEnergy, FemContact};
 
-impl ContactModel {
+impl FemContact {
     /// Append the dynamic state to `w`.
     pub fn save_state(&self, w: &mut StateWriter) {
         w.vec3s("contact.stick", &self.stick);

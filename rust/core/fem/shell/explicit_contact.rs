@@ -1,7 +1,7 @@
 //! Initial velocity, gravity and contact for the explicit shell solver [`ShellExplicit`].
 //!
-//! Contact acts on the translational dofs only: the [`ContactModel`] (built with
-//! [`ContactModel::new_shell`], two-sided faces offset by half the thickness) gets the
+//! Contact acts on the translational dofs only: the [`FemContact`] (built with
+//! [`FemContact::new_shell`], two-sided faces offset by half the thickness) gets the
 //! nodes' translations u and velocities v^{n−½} and returns nodal forces, which enter the
 //! step as external forces (so the solver's exact discrete balance E_kin + E_int − W_ext =
 //! E_0 counts their work). The stable step is certified for the element bound plus the
@@ -10,7 +10,7 @@
 //! fixed one above the new limit is refused, as in [`crate::fem::explicit`].
 
 use crate::error::{DemfemError, Result};
-use crate::fem::contact::{ContactEnergy, ContactModel};
+use crate::fem::contact::{ContactEnergy, FemContact};
 use crate::fem::stable_step::critical_step_from_eigenvalue;
 
 use super::ShellExplicit;
@@ -157,13 +157,13 @@ impl ShellExplicit {
     /// step is re-certified with the contact's allowance; an automatic step is reduced to
     /// fit, a fixed step above the new limit is refused; shells overlapping at the start
     /// are refused.
-    pub fn set_contact(&mut self, mut contact: ContactModel) -> Result<()> {
+    pub fn set_contact(&mut self, mut contact: FemContact) -> Result<()> {
         self.require_start("contact")?;
         if !contact.is_shell() {
             return Err(DemfemError::InvalidParameter {
                 field: "contact".into(),
                 value: "a contact model of a solid mesh".into(),
-                allowed: "a model from ContactModel::new_shell".into(),
+                allowed: "a model from FemContact::new_shell".into(),
             });
         }
         let mass = self.node_mass();
@@ -193,7 +193,7 @@ impl ShellExplicit {
     }
 
     /// The attached contact model.
-    pub fn contact(&self) -> Option<&ContactModel> {
+    pub fn contact(&self) -> Option<&FemContact> {
         self.contact.as_ref()
     }
     /// Contact energies (zero without contact).

@@ -16,7 +16,7 @@ use crate::rigid::collision::{
     clump_polygon_contacts, exact_exact_contacts, exact_plane_contacts, exact_polygon_contacts,
     BodyPose, ContactPoint, Plane,
 };
-use crate::rigid::forces::ContactModel;
+use crate::rigid::forces::RigidContactLaw;
 use crate::rigid::shape::{BoundingCapsule, RigidShape};
 
 /// Key of a contact's friction history: (first object << 32 | second object, feature on the
@@ -28,7 +28,7 @@ pub(super) type ContactKey = (u64, u64, u64);
 /// first map (zero for a new contact) and the updated one stored in the second.
 #[allow(clippy::too_many_arguments)]
 fn force_with_history(
-    model: &ContactModel,
+    model: &RigidContactLaw,
     contact: &ContactPoint,
     relative_velocity: &Vector3<f64>,
     effective_mass: f64,
