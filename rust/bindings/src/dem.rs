@@ -306,17 +306,7 @@ impl DemSimulation {
     /// raises SimulationInterrupted with the state consistent at a step boundary.
     #[pyo3(signature = (n, chunk=2000))]
     fn step(&mut self, py: Python<'_>, n: &Bound<'_, PyAny>, chunk: i64) -> PyResult<()> {
-        let n = checked_steps(step_count_arg(n)?, self.sim.time(), self.sim.dt())?;
-        let chunk = count("chunk", chunk)?;
-        run_in_chunks(
-            py,
-            &mut self.sim,
-            n,
-            chunk,
-            |sim, k| sim.step(k),
-            |sim| (sim.time(), sim.steps()),
-            |_| Ok(()),
-        )
+        self.step_count(py, step_count_arg(n)?, chunk)
     }
 
     /// Advance until the simulated time reaches `t_end` (s); returns the steps taken.
@@ -325,7 +315,7 @@ impl DemSimulation {
         let n = steps_until(t_end, self.sim.time(), self.sim.dt())?;
         let steps = i64::try_from(n)
             .map_err(|_| invalid("t_end", &t_end.to_string(), "reachable in < 2^63 steps"))?;
-        self.step(py, steps, chunk)?;
+        self.step_count(py, steps, chunk)?;
         Ok(n)
     }
 
@@ -648,7 +638,22 @@ impl DemSimulation {
     }
 }
 
-impl DemSimulation {}
+impl DemSimulation {
+    /// Advance `n` steps (a count checked against the finite time), `chunk` at a time.
+    fn step_count(&mut self, py: Python<'_>, n: i64, chunk: i64) -> PyResult<()> {
+        let n = checked_steps(n, self.sim.time(), self.sim.dt())?;
+        let chunk = count("chunk", chunk)?;
+        run_in_chunks(
+            py,
+            &mut self.sim,
+            n,
+            chunk,
+            |sim, k| sim.step(k),
+            |sim| (sim.time(), sim.steps()),
+            |_| Ok(()),
+        )
+    }
+}
 
 /// Register the DEM classes on the extension module.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
