@@ -80,3 +80,15 @@ def test_the_hourly_figures_agree():
 def test_inconsistent_logs_are_refused(args, match):
     with pytest.raises(InvalidParameterError, match=match):
         passages(*args)
+
+
+def test_surface_probability_refuses_nan_stress_and_negative_area():
+    from demfem.assess.risk_stage import surface_probability
+    from demfem.risk import OUTER_SURFACE
+
+    with pytest.raises(InvalidParameterError, match="stress"):
+        surface_probability(OUTER_SURFACE, np.array([1e6, np.nan]), np.array([1e-6, 1e-6]))
+    with pytest.raises(InvalidParameterError, match="area"):
+        surface_probability(OUTER_SURFACE, np.array([1e6]), np.array([-1e-6]))
+    p = surface_probability(OUTER_SURFACE, np.array([0.0, 70e6]), np.array([1e-6, 1e-4]))
+    assert p[0] == 0.0 and p[1] == pytest.approx(1 - math.exp(-1.0), rel=1e-12)
