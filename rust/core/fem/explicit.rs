@@ -27,14 +27,16 @@
 //! one the scheme conserves; it differs from ½ v·Mv at the same instant by O((ωΔt)²) per
 //! mode. At n = 0, v^{−½} := v^0 − (Δt/2) a^0.
 //!
-//! Layout: `config` (settings and the energy report), `contact` (contact attached to a
-//! run), `state` (checkpoints), `tet` and `shell` (the constructors of the two kinds).
+//! Layout: `config` (settings and the energy report), `update` (the pass over the nodes),
+//! `contact` (contact attached to a run), `state` (checkpoints), `tet` and `shell` (the
+//! constructors of the two kinds).
 
 mod config;
 mod contact;
 mod shell;
 mod state;
 mod tet;
+mod update;
 
 pub use config::{EnergyReport, ExplicitConfig, LoadHistory, Prescribed, PrescribedKind};
 pub use contact::EnergyBalance;
@@ -48,6 +50,8 @@ use crate::fem::contact::FemContact;
 use crate::fem::element_set::{Clock, ElementSet, LumpedMass};
 use crate::fem::reduce::det_sum;
 use crate::fem::stable_step::{critical_step_from_eigenvalue, EigenvalueBound};
+
+use update::{Chunk, NodePass};
 
 /// Boundary condition of a dof: free.
 const FREE: u8 = 0;
@@ -532,85 +536,58 @@ impl<E: ElementSet<D>, const D: usize> Explicit<E, D> {
             let v = E::translations(&self.v, &mut self.v3);
             c.compute(u, v, t, dt, &mut self.f_contact);
         }
-        let has_contact = self.contact.is_some();
-        let lf = self.load_history.factor(t);
-        let bf_next = self.bc_history.factor(t + dt);
         let chunk = E::NODE_CHUNK;
-        // One fused, deterministic pass over nodes: damping and external forces at t^n,
-        // velocity update (free, prescribed or held), reactions, energy increments, and the
-        // displacement update. Partial sums per fixed chunk are added in chunk order.
-        let partial: Vec<[f64; 4]> = {
-            let mass = &self.mass;
-            let rotary = &self.rotary;
-            let f_int = &self.f_int;
-            let loads = &self.loads;
-            let extra = &self.extra_loads;
-            let fc = &self.f_contact;
-            let bc_kind = &self.bc_kind;
-            let bc_value = &self.bc_value;
-            self.v
-                .par_chunks_mut(chunk)
-                .zip(self.u.par_chunks_mut(chunk))
-                .zip(self.du_prev.par_chunks_mut(chunk))
-                .zip(self.f_total_prev.par_chunks_mut(chunk))
-                .zip(self.f_damp.par_chunks_mut(chunk))
-                .zip(self.f_damp_prev.par_chunks_mut(chunk))
-                .zip(self.f_ext.par_chunks_mut(chunk))
-                .enumerate()
-                .map(|(c, ((((((vc, uc), duc), ftp), fd), fdp), fe))| {
-                    let n0 = c * chunk;
-                    let mut acc = [0.0f64; 4];
-                    for k in 0..vc.len() {
-                        let i = n0 + k;
-                        for d in 0..D {
-                            let m = if d < 3 { mass[i] } else { rotary[i] };
-                            let v_old = vc[k][d];
-                            // βK v^{n−½} is in fd when β > 0; add αM v^{n−½}.
-                            let stiff = if beta > 0.0 { fd[k][d] } else { 0.0 };
-                            let damp = stiff + alpha * m * v_old;
-                            let f_ext = if has_contact && d < 3 {
-                                loads[i][d] * lf + extra[i][d] + fc[i][d]
-                            } else {
-                                loads[i][d] * lf + extra[i][d]
-                            };
-                            fe[k][d] = f_ext;
-                            let resid = f_ext - f_int[i][d] - damp;
-                            let u_old = uc[k][d];
-                            let (v_new, f_total) = match bc_kind[i][d] {
-                                FREE => (v_old + dt_n * resid / m, f_ext + 0.0),
-                                HELD => {
-                                    // Held where it is: the total external force on the
-                                    // dof is M a + f_int + d.
-                                    let a = -v_old / dt_n;
-                                    (0.0, m * a + f_int[i][d] + damp)
-                                }
-                                kind => {
-                                    let vn = if kind == DISPLACEMENT {
-                                        (bc_value[i][d] * bf_next - u_old) / dt
-                                    } else {
-                                        bc_value[i][d]
-                                    };
-                                    let a = (vn - v_old) / dt_n;
-                                    (vn, f_ext + (m * a - resid))
-                                }
-                            };
-                            let v_prev = if first { 2.0 * v_old - v_new } else { v_old };
-                            acc[0] += 0.5 * m * v_prev * v_new;
-                            acc[1] += 0.5 * duc[k][d] * (ftp[k][d] + f_total);
-                            acc[2] += 0.5 * duc[k][d] * (fdp[k][d] + damp);
-                            acc[3] += 0.5 * u_old * f_int[i][d];
-                            vc[k][d] = v_new;
-                            ftp[k][d] = f_total;
-                            fdp[k][d] = damp;
-                            let du = dt * v_new;
-                            uc[k][d] = u_old + du;
-                            duc[k][d] = du;
-                        }
-                    }
-                    acc
-                })
-                .collect()
+        let damped = alpha > 0.0 || beta > 0.0;
+        // One fused, deterministic pass over nodes (see `update`); partial sums per fixed
+        // chunk are added in chunk order.
+        let pass = NodePass {
+            mass: &self.mass,
+            rotary: &self.rotary,
+            f_int: &self.f_int,
+            loads: &self.loads,
+            extra: &self.extra_loads,
+            f_contact: &self.f_contact,
+            bc_kind: &self.bc_kind,
+            bc_value: &self.bc_value,
+            has_contact: self.contact.is_some(),
+            alpha,
+            beta,
+            dt,
+            dt_n,
+            first,
+            load_factor: self.load_history.factor(t),
+            bc_factor_next: self.bc_history.factor(t + dt),
         };
+        let partial: Vec<[f64; 4]> = self
+            .v
+            .par_chunks_mut(chunk)
+            .zip(self.u.par_chunks_mut(chunk))
+            .zip(self.du_prev.par_chunks_mut(chunk))
+            .zip(self.f_total_prev.par_chunks_mut(chunk))
+            .zip(self.f_damp.par_chunks(chunk))
+            .zip(self.f_damp_prev.par_chunks_mut(chunk))
+            .zip(self.f_ext.par_chunks_mut(chunk))
+            .enumerate()
+            .map(
+                |(c, ((((((v, u), du_prev), f_total_prev), f_damp), f_damp_prev), f_ext))| {
+                    let c = Chunk {
+                        n0: c * chunk,
+                        v,
+                        u,
+                        du_prev,
+                        f_total_prev,
+                        f_damp,
+                        f_damp_prev,
+                        f_ext,
+                    };
+                    if damped {
+                        pass.chunk::<true>(c)
+                    } else {
+                        pass.chunk::<false>(c)
+                    }
+                },
+            )
+            .collect();
         let (mut e_kin, mut w_ext, mut w_damp, mut e_int) = (0.0, 0.0, 0.0, 0.0);
         for p in &partial {
             e_kin += p[0];
