@@ -93,14 +93,25 @@ fn bench_fem(c: &mut Criterion) {
         .filter(|&i| model.mesh.nodes[i][2] < 1e-9)
         .flat_map(|i| (0..6).map(move |k| (i, k)))
         .collect();
-    let mut shell = demfem::fem::shell::ShellExplicit::new(&model, &fixed, None).unwrap();
-    let mut f = vec![0.0; model.n_dofs()];
-    for (i, x) in model.mesh.nodes.iter().enumerate() {
-        if x[2] > 64e-3 - 1e-9 {
-            f[6 * i + 1] = 1.0;
-        }
-    }
-    shell.set_loads(&f).unwrap();
+    let mut shell = demfem::fem::ShellExplicit::new(&model, &fixed, None).unwrap();
+    let f: Vec<[f64; 6]> = model
+        .mesh
+        .nodes
+        .iter()
+        .map(|x| {
+            [
+                0.0,
+                if x[2] > 64e-3 - 1e-9 { 1.0 } else { 0.0 },
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+            ]
+        })
+        .collect();
+    shell
+        .set_loads(f, demfem::fem::LoadHistory::Constant)
+        .unwrap();
     println!(
         "shell mesh: {} nodes, {} triangles, dt_limit {:.3e} s",
         model.mesh.nodes.len(),

@@ -11,7 +11,7 @@ use std::collections::HashMap;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use demfem::rigid::{
-    BeadClump, ContactMaterial, RigidContactLaw, ContactPoint, MassProperties, Plane, RigidScene,
+    BeadClump, ContactMaterial, ContactPoint, MassProperties, Plane, RigidContactLaw, RigidScene,
     RigidSceneConfig, RigidShape,
 };
 use nalgebra::{UnitQuaternion, Vector3};

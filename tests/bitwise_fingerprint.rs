@@ -18,11 +18,13 @@ use common::alternating_triangles;
 use demfem::dem::table::{anchor_scene, TableStart};
 use demfem::dem::{DemContactLaw as DemLaw, Simulation};
 use demfem::fem::contact::{
-    FemContact, ContactSettings, NoTensionSpring, RigidShape, RigidSurface,
+    ContactSettings, FemContact, NoTensionSpring, RigidShape, RigidSurface,
 };
+use demfem::fem::explicit::dof_rows;
 use demfem::fem::mesh::{box_tet_mesh, place, union, TriMesh};
-use demfem::fem::shell::{ShellExplicit, ShellModel};
+use demfem::fem::shell::ShellModel;
 use demfem::fem::stress::{element_stresses, max_principal_stress};
+use demfem::fem::ShellExplicit;
 use demfem::fem::{
     AxisymmetricProfile, ExplicitConfig, ExplicitSolver, LinearElastic, LoadHistory, Prescribed,
     PrescribedKind,
@@ -376,7 +378,7 @@ fn shell_cluster_setup() -> (ShellModel, ShellExplicit) {
             v[6 * i] = -0.18;
         }
     }
-    s.set_initial_velocity(&v).unwrap();
+    s.set_initial_velocity(&dof_rows(&v).unwrap()).unwrap();
     s.add_gravity([0.0, 0.0, -9.81]).unwrap();
     s.set_contact(c).unwrap();
     (model, s)
@@ -384,9 +386,11 @@ fn shell_cluster_setup() -> (ShellModel, ShellExplicit) {
 
 fn shell_report(name: &str, model: &ShellModel, s: &ShellExplicit) {
     let c = s.contact().unwrap();
-    let e = s.energy_report();
+    let e = s.energy_balance();
     let ce = s.contact_energy();
-    let sig = model.max_principal_stresses(s.displacement()).unwrap();
+    let sig = model
+        .max_principal_stresses(s.displacement().as_flattened())
+        .unwrap();
     let s1 = sig.iter().flatten().cloned().fold(f64::MIN, f64::max);
     let p = peaks(c.history(), c.channels().len());
     line(
@@ -397,7 +401,13 @@ fn shell_report(name: &str, model: &ShellModel, s: &ShellExplicit) {
             ("time", s.time()),
             (
                 "u_v_hash",
-                f64::from_bits(hash(s.displacement().iter().chain(s.velocity()).cloned())),
+                f64::from_bits(hash(
+                    s.displacement()
+                        .iter()
+                        .chain(s.velocity())
+                        .flatten()
+                        .cloned(),
+                )),
             ),
             (
                 "f_contact_hash",
@@ -454,13 +464,17 @@ fn shell_fixed_fingerprint() {
         }
     }
     let mut s = ShellExplicit::new(&model, &fixed, None).unwrap();
-    s.set_loads(&model.area_load([0.0, 0.0, -1e4])).unwrap();
+    s.set_loads(
+        dof_rows(&model.area_load([0.0, 0.0, -1e4])).unwrap(),
+        LoadHistory::Constant,
+    )
+    .unwrap();
     s.add_gravity([0.0, 0.0, -9.81]).unwrap();
     let nd = 6 * mesh.nodes.len();
     let u0: Vec<f64> = (0..nd)
         .map(|d| if d % 6 == 2 { 1e-8 } else { 0.0 })
         .collect();
-    s.set_initial_displacement(&u0).unwrap();
+    s.set_initial_displacement(&dof_rows(&u0).unwrap()).unwrap();
     let v0: Vec<f64> = (0..nd)
         .map(|d| {
             if fixed.iter().any(|&(i, k)| 6 * i + k == d) || d % 6 != 2 {
@@ -470,10 +484,12 @@ fn shell_fixed_fingerprint() {
             }
         })
         .collect();
-    s.set_initial_velocity(&v0).unwrap();
+    s.set_initial_velocity(&dof_rows(&v0).unwrap()).unwrap();
     s.run(400).unwrap();
-    let e = s.energy_report();
-    let sig = model.max_principal_stresses(s.displacement()).unwrap();
+    let e = s.energy_balance();
+    let sig = model
+        .max_principal_stresses(s.displacement().as_flattened())
+        .unwrap();
     let s1 = sig.iter().flatten().cloned().fold(f64::MIN, f64::max);
     line(
         "shell_fixed",
@@ -483,7 +499,13 @@ fn shell_fixed_fingerprint() {
             ("time", s.time()),
             (
                 "u_v_hash",
-                f64::from_bits(hash(s.displacement().iter().chain(s.velocity()).cloned())),
+                f64::from_bits(hash(
+                    s.displacement()
+                        .iter()
+                        .chain(s.velocity())
+                        .flatten()
+                        .cloned(),
+                )),
             ),
             ("kinetic", e.kinetic),
             ("internal", e.internal),

@@ -6,7 +6,7 @@
 
 use demfem::error::DemfemError;
 use demfem::fem::contact::{
-    FemContact, ContactSettings, NoTensionSpring, RigidShape, RigidSurface,
+    ContactSettings, FemContact, NoTensionSpring, RigidShape, RigidSurface,
 };
 use demfem::fem::mesh::{ball_tet_mesh, place, union};
 use demfem::fem::{ExplicitConfig, ExplicitSolver, LinearElastic};

@@ -5,7 +5,7 @@
 //! conservation, convergence in the penalty scale, and bitwise equality on 1 and 2 threads.
 
 use demfem::fem::contact::{
-    FemContact, ContactSettings, NoTensionSpring, RigidShape, RigidSurface,
+    ContactSettings, FemContact, NoTensionSpring, RigidShape, RigidSurface,
 };
 use demfem::fem::mesh::{ball_tet_mesh, box_tet_mesh, place, union};
 use demfem::fem::{ExplicitConfig, ExplicitSolver, LinearElastic, LoadHistory, TetMesh};

@@ -278,3 +278,58 @@ pub(crate) fn young_modulus(value: Option<f64>, alias: Option<f64>) -> PyResult<
 pub(crate) fn required<T>(name: &str, value: Option<T>) -> PyResult<T> {
     value.ok_or_else(|| PyTypeError::new_err(format!("missing required argument: '{name}'")))
 }
+
+/// Per-node dof vectors from an (`n`, 3) array (the translations; other dofs 0) or an
+/// (`n`, D) array (every dof, e.g. a shell node's 3 translations and 3 rotations).
+pub(crate) fn node_dofs<const D: usize>(
+    a: &PyReadonlyArray2<'_, f64>,
+    field: &str,
+    n: usize,
+) -> PyResult<Vec<[f64; D]>> {
+    let v = a.as_array();
+    if v.nrows() != n || (v.ncols() != 3 && v.ncols() != D) {
+        let allowed = if D == 3 {
+            format!("({n}, 3)")
+        } else {
+            format!("({n}, 3) or ({n}, {D})")
+        };
+        return Err(shape_err(
+            field,
+            format!("expected shape {allowed}, got {:?}", v.shape()),
+        ));
+    }
+    Ok(v.rows()
+        .into_iter()
+        .map(|r| {
+            let mut x = [0.0; D];
+            for (xi, ri) in x.iter_mut().zip(r.iter()) {
+                *xi = *ri;
+            }
+            x
+        })
+        .collect())
+}
+
+/// Element connectivity from an (E, `K`) integer array (node indices ≥ 0; that they exist
+/// is left to the mesh's own validation).
+pub(crate) fn connectivity<const K: usize>(
+    a: &PyReadonlyArray2<'_, i64>,
+    field: &str,
+) -> PyResult<Vec<[usize; K]>> {
+    let t = a.as_array();
+    if t.ncols() != K {
+        return Err(shape_err(
+            field,
+            format!("expected shape (n, {K}), got {:?}", t.shape()),
+        ));
+    }
+    let mut out = Vec::with_capacity(t.nrows());
+    for r in t.rows() {
+        let mut e = [0usize; K];
+        for (ei, &i) in e.iter_mut().zip(r.iter()) {
+            *ei = usize::try_from(i).map_err(|_| shape_err(field, "negative node index".into()))?;
+        }
+        out.push(e);
+    }
+    Ok(out)
+}

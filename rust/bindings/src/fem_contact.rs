@@ -5,13 +5,9 @@ use numpy::{PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use demfem::fem::contact::{
-    ContactSettings, FemContact, NoTensionSpring, RigidShape, RigidSurface,
-};
-use demfem::fem::{LinearElastic, TetMesh, TriMesh};
+use demfem::fem::contact::{FemContact, NoTensionSpring, RigidShape, RigidSurface};
 use demfem::DemfemError;
 
-use crate::convert::ids;
 use crate::error::core_err as err;
 
 fn vec3(t: [f64; 3]) -> [f64; 3] {
@@ -72,65 +68,9 @@ fn rigid(r: &PyRigid) -> PyResult<RigidSurface> {
     })
 }
 
-/// Build the contact model of `mesh` from the Python arguments.
-#[allow(clippy::too_many_arguments)]
-pub fn build(
-    mesh: &TetMesh,
-    material: &LinearElastic,
-    body_of_node: PyReadonlyArray1<'_, i64>,
-    region_of_node: PyReadonlyArray1<'_, i64>,
-    settings: ContactSettings,
-    rigid_surfaces: Vec<PyRigid>,
-    spring_nodes: Option<PyReadonlyArray1<'_, i64>>,
-    spring_anchors: Option<PyReadonlyArray2<'_, f64>>,
-    spring_stiffness: Option<PyReadonlyArray1<'_, f64>>,
-    spring_rest_length: Option<PyReadonlyArray1<'_, f64>>,
-) -> PyResult<FemContact> {
-    let n = mesh.nodes.len();
-    let body = ids(&body_of_node, "body_of_node", n)?;
-    let region = ids(&region_of_node, "region_of_node", n)?;
-    let c = FemContact::new(mesh, &body, &region, material, settings).map_err(err)?;
-    extras(
-        c,
-        rigid_surfaces,
-        spring_nodes,
-        spring_anchors,
-        spring_stiffness,
-        spring_rest_length,
-    )
-}
-
-/// Build the contact model of the shell mesh `mesh` from the Python arguments (two-sided
-/// faces offset by half the thickness, penalty s·E·t).
-#[allow(clippy::too_many_arguments)]
-pub fn build_shell(
-    mesh: &TriMesh,
-    material: &LinearElastic,
-    body_of_node: PyReadonlyArray1<'_, i64>,
-    region_of_node: PyReadonlyArray1<'_, i64>,
-    settings: ContactSettings,
-    rigid_surfaces: Vec<PyRigid>,
-    spring_nodes: Option<PyReadonlyArray1<'_, i64>>,
-    spring_anchors: Option<PyReadonlyArray2<'_, f64>>,
-    spring_stiffness: Option<PyReadonlyArray1<'_, f64>>,
-    spring_rest_length: Option<PyReadonlyArray1<'_, f64>>,
-) -> PyResult<FemContact> {
-    let n = mesh.nodes.len();
-    let body = ids(&body_of_node, "body_of_node", n)?;
-    let region = ids(&region_of_node, "region_of_node", n)?;
-    let c = FemContact::new_shell(mesh, &body, &region, material, settings).map_err(err)?;
-    extras(
-        c,
-        rigid_surfaces,
-        spring_nodes,
-        spring_anchors,
-        spring_stiffness,
-        spring_rest_length,
-    )
-}
-
-/// Add the rigid surfaces and springs to a contact model.
-fn extras(
+/// Add the rigid surfaces and the no-tension springs, as Python passes them, to a contact
+/// model.
+pub fn add_surfaces_and_springs(
     mut c: FemContact,
     rigid_surfaces: Vec<PyRigid>,
     spring_nodes: Option<PyReadonlyArray1<'_, i64>>,

@@ -14,6 +14,8 @@ mod error;
 mod fem;
 mod fem_contact;
 mod fem_shell;
+mod fem_solver;
+mod fem_tet;
 mod rigid;
 mod run;
 
@@ -23,6 +25,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     contact_laws::register(m)?;
     dem::register(m)?;
     fem::register(m)?;
+    fem_tet::register(m)?;
     fem_shell::register(m)?;
     rigid::register(m)?;
     Ok(())

@@ -146,7 +146,12 @@ pub struct PairLaw {
 
 impl PairLaw {
     /// Derive the pair parameters of materials `a` and `b` under `model`.
-    pub fn new(a: &Material, b: &Material, model: DemContactLaw, clamp: ForceClamp) -> Result<Self> {
+    pub fn new(
+        a: &Material,
+        b: &Material,
+        model: DemContactLaw,
+        clamp: ForceClamp,
+    ) -> Result<Self> {
         let restitution = a.restitution.min(b.restitution);
         let zeta = if model.is_hertzian() {
             contact::tsuji_damping_for_restitution(restitution, clamp)?

@@ -49,6 +49,11 @@ impl StateWriter {
 
     /// A section of 3-vectors (3 f64 each).
     pub fn vec3s(&mut self, name: &str, v: &[[f64; 3]]) {
+        self.vecs(name, v);
+    }
+
+    /// A section of `D`-vectors (`D` f64 each; the count is the number of vectors).
+    pub fn vecs<const D: usize>(&mut self, name: &str, v: &[[f64; D]]) {
         self.header(name, v.len());
         for x in v {
             for c in x {
@@ -172,12 +177,28 @@ impl<'a> StateReader<'a> {
 
     /// A section of 3-vectors.
     pub fn vec3s(&mut self, name: &str, expected: Option<usize>) -> Result<Vec<[f64; 3]>> {
+        self.vecs(name, expected)
+    }
+
+    /// A section of `D`-vectors (of `expected` vectors when given).
+    pub fn vecs<const D: usize>(
+        &mut self,
+        name: &str,
+        expected: Option<usize>,
+    ) -> Result<Vec<[f64; D]>> {
         let flat: Vec<f64> = self
-            .words::<8>(name, expected, 3)?
+            .words::<8>(name, expected, D)?
             .into_iter()
             .map(f64::from_le_bytes)
             .collect();
-        Ok(flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
+        Ok(flat
+            .chunks_exact(D)
+            .map(|c| {
+                let mut a = [0.0; D];
+                a.copy_from_slice(c);
+                a
+            })
+            .collect())
     }
 
     /// A section of u64.

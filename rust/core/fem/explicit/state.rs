@@ -1,11 +1,13 @@
-//! Save and restore the explicit solver's dynamic state, contact included (see
-//! [`crate::fem::state_io`]): build the solver from the same inputs, call
-//! [`ExplicitSolver::restore_state`], and the run continues bitwise where it was saved.
+//! Save and restore an explicit run's dynamic state, contact included (see
+//! [`crate::fem::state_io`]), in one layout for every element kind: build the solver from
+//! the same inputs, call [`Explicit::restore_state`], and the run continues bitwise where it
+//! was saved.
 
 use crate::error::{DemfemError, Result};
+use crate::fem::element_set::ElementSet;
 use crate::fem::state_io::{StateReader, StateWriter};
 
-use super::{EnergyReport, ExplicitSolver};
+use super::{EnergyReport, Explicit};
 
 fn report_to(e: &EnergyReport) -> [f64; 6] {
     [
@@ -29,20 +31,20 @@ fn report_from(c: &[f64]) -> EnergyReport {
     }
 }
 
-impl ExplicitSolver {
+impl<E: ElementSet<D>, const D: usize> Explicit<E, D> {
     /// The dynamic state as bytes: displacements, velocities, the force and work memory of
     /// the integrator, time, steps, energies, and the contact model's state.
     pub fn save_state(&self) -> Vec<u8> {
         let mut w = StateWriter::new();
-        w.vec3s("u", &self.u);
-        w.vec3s("v", &self.v);
-        w.vec3s("f_int", &self.f_int);
-        w.vec3s("f_damp", &self.f_damp);
-        w.vec3s("f_ext", &self.f_ext);
-        w.vec3s("f_total_prev", &self.f_total_prev);
-        w.vec3s("f_damp_prev", &self.f_damp_prev);
-        w.vec3s("du_prev", &self.du_prev);
-        w.vec3s("extra_loads", &self.extra_loads);
+        w.vecs("u", &self.u);
+        w.vecs("v", &self.v);
+        w.vecs("f_int", &self.f_int);
+        w.vecs("f_damp", &self.f_damp);
+        w.vecs("f_ext", &self.f_ext);
+        w.vecs("f_total_prev", &self.f_total_prev);
+        w.vecs("f_damp_prev", &self.f_damp_prev);
+        w.vecs("du_prev", &self.du_prev);
+        w.vecs("extra_loads", &self.extra_loads);
         w.vec3s("f_contact", &self.f_contact);
         w.f64s("clock", &[self.time, self.dt]);
         w.u64s("steps", &[self.steps]);
@@ -62,15 +64,15 @@ impl ExplicitSolver {
     pub fn restore_state(&mut self, bytes: &[u8]) -> Result<()> {
         let mut r = StateReader::new(bytes)?;
         let n = self.u.len();
-        let u = r.vec3s("u", Some(n))?;
-        let v = r.vec3s("v", Some(n))?;
-        let f_int = r.vec3s("f_int", Some(n))?;
-        let f_damp = r.vec3s("f_damp", Some(n))?;
-        let f_ext = r.vec3s("f_ext", Some(n))?;
-        let f_total_prev = r.vec3s("f_total_prev", Some(n))?;
-        let f_damp_prev = r.vec3s("f_damp_prev", Some(n))?;
-        let du_prev = r.vec3s("du_prev", Some(n))?;
-        let extra_loads = r.vec3s("extra_loads", Some(n))?;
+        let u = r.vecs("u", Some(n))?;
+        let v = r.vecs("v", Some(n))?;
+        let f_int = r.vecs("f_int", Some(n))?;
+        let f_damp = r.vecs("f_damp", Some(n))?;
+        let f_ext = r.vecs("f_ext", Some(n))?;
+        let f_total_prev = r.vecs("f_total_prev", Some(n))?;
+        let f_damp_prev = r.vecs("f_damp_prev", Some(n))?;
+        let du_prev = r.vecs("du_prev", Some(n))?;
+        let extra_loads = r.vecs("extra_loads", Some(n))?;
         let f_contact = r.vec3s("f_contact", Some(self.f_contact.len()))?;
         let clock = r.f64s("clock", Some(2))?;
         let steps = r.u64s("steps", Some(1))?;
