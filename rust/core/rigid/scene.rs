@@ -370,6 +370,13 @@ impl RigidScene {
             mass: mass.mass,
             principal_inertia: mass.principal_inertia,
         })?;
+        let (shape, mass) = &self.shapes[shape_id];
+        if matches!(shape, RigidShape::Revolution(_))
+            && mass.principal_inertia.x == mass.principal_inertia.y
+        {
+            // bodies of revolution turn as symmetric tops, in closed form
+            self.bodies.set_symmetric_top(index, true)?;
+        }
         self.body_shape.push(shape_id);
         self.alive.push(true);
         self.coordination.push(0);
@@ -386,7 +393,11 @@ impl RigidScene {
             .model
             .e_star_body_body
             .max(self.model.e_star_body_plane);
-        for &shape_id in &self.body_shape {
+        // each shape in use once: the limit is the same for every body of a shape
+        let mut in_use = self.body_shape.clone();
+        in_use.sort_unstable();
+        in_use.dedup();
+        for &shape_id in &in_use {
             let (shape, mass) = &self.shapes[shape_id];
             let m_eff = smallest_effective_mass(shape.surface_sample(), mass);
             let radius = shape.min_contact_radius();

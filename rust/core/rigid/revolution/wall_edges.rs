@@ -20,7 +20,7 @@ use nalgebra::Vector3;
 
 use super::contacts::{belongs_to, feature_radius, line_pair, line_samples, piece_rod, Rod};
 use super::features::{
-    circle_point, in_cone, periodic_minimum, segment_parameters, Feature, Placed, Sweep,
+    circle_minimum, circle_point, in_cone, segment_parameters, Feature, Placed, Sweep,
 };
 use crate::rigid::collision::ContactPoint;
 
@@ -45,8 +45,7 @@ fn circle_segment(x: &Placed, k: usize, start: &V3, t: &V3, length: f64) -> Opti
     let r = circle.r;
     let (a0, ac, as_) = (q0.norm_squared() + r * r, 2.0 * r * q0.dot(&x.x), 2.0 * r * q0.dot(&x.y));
     let (b0, bc, bs) = (q0.dot(t), r * x.x.dot(t), r * x.y.dot(t));
-    let eval = |theta: f64| -> (f64, f64, f64) {
-        let (s, c) = theta.sin_cos();
+    let eval = |c: f64, s: f64| -> (f64, f64, f64) {
         let av = a0 + ac * c + as_ * s;
         let da = -ac * s + as_ * c;
         let bv = b0 + bc * c + bs * s;
@@ -57,8 +56,18 @@ fn circle_segment(x: &Placed, k: usize, start: &V3, t: &V3, length: f64) -> Opti
             -(av - a0) - 2.0 * (db * db - bv * (bv - b0)),
         )
     };
-    let (theta, _) = periodic_minimum(8, eval);
-    let (p, _, tangent) = circle_point(x, k, theta);
+    // nearly parallel to the axis, the edge faces the circle where it passes nearest
+    let centre = x.at(circle.z);
+    let guess = if x.axis.dot(t).abs() > 0.95 {
+        let w = start + t * (centre - start).dot(t) - centre;
+        let (c, s) = (w.dot(&x.x), w.dot(&x.y));
+        let n = c.hypot(s);
+        (n > 0.5 * r).then(|| (c / n, s / n))
+    } else {
+        None
+    };
+    let (u, _) = circle_minimum(guess, eval);
+    let (p, _, tangent) = circle_point(x, k, u);
     let u = (p - start).dot(t);
     if !(u > 0.0 && u < length) {
         return None;
@@ -213,7 +222,7 @@ pub fn edge_contacts(
             normal: c.1,
             overlap: -c.0,
             radius_first: f64::INFINITY,
-            radius_second: feature_radius(body, c.4, &c.3, &(-c.1)),
+            radius_second: feature_radius(body, c.4, &c.3),
             feature_first: key,
             feature_second: c.4.key(),
         });

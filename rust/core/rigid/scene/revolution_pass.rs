@@ -55,6 +55,8 @@ pub(crate) struct RevolutionPass {
     pair_scratch: PairScratch,
     clump_scratch: ClumpPairScratch,
     rebuilds: u64,
+    /// Each body's axis, x and y in the world for this evaluation.
+    frames: Vec<[V3; 3]>,
     /// The deepest overlap of the last evaluation: (body, partner, partner is a boundary,
     /// overlap m).
     deepest: Option<(usize, usize, bool, f64)>,
@@ -78,14 +80,32 @@ fn placed<'a>(shape: &'a crate::rigid::RevolutionShape, pose: &BodyPose) -> Plac
     }
 }
 
+/// A body placed with its frame of this evaluation (see `RevolutionPass::frames`).
+#[inline]
+fn placed_with<'a>(
+    shape: &'a crate::rigid::RevolutionShape,
+    position: V3,
+    frame: &[V3; 3],
+) -> Placed<'a> {
+    Placed {
+        shape,
+        origin: position,
+        axis: frame[0],
+        x: frame[1],
+        y: frame[2],
+    }
+}
+
 /// A body's bounding capsule inflated by half the skin, and the box around it: (lower x,
 /// upper x, lower corner, upper corner, axis start, axis end, radius, body).
 type CapsuleBox = (f64, f64, V3, V3, V3, V3, f64, u32);
 
-/// Rotation angle between two orientations, rad.
-fn rotation_angle(a: &UnitQuaternion<f64>, b: &UnitQuaternion<f64>) -> f64 {
-    let d = a.inverse() * b;
-    2.0 * d.imag().norm().atan2(d.w.abs())
+/// An upper bound of the rotation angle between two orientations, rad: with the nearer
+/// of ±b, |a − b| = 2 sin(θ/4) ≥ θ/π·√2 for θ ≤ π, so θ ≤ 2.23 |a − b|.
+fn rotation_bound(a: &UnitQuaternion<f64>, b: &UnitQuaternion<f64>) -> f64 {
+    let (qa, qb) = (a.coords, b.coords);
+    let d = (qa - qb).norm().min((qa + qb).norm());
+    2.23 * d
 }
 
 impl RigidScene {
@@ -127,7 +147,7 @@ impl RigidScene {
                 let (x0, q0) = pass.reference[i];
                 let r = self.shapes[self.body_shape[i]].0.bounding_radius();
                 (self.bodies.position[i] - x0).norm()
-                    + r * rotation_angle(&q0, &self.bodies.orientation[i])
+                    + r * rotation_bound(&q0, &self.bodies.orientation[i])
                     > 0.5 * pass.skin
             });
         if !stale {
@@ -251,6 +271,12 @@ impl RigidScene {
         let mut elastic_energy = 0.0;
         let mut contacts = std::mem::take(&mut pass.contacts);
         let mut weights = std::mem::take(&mut pass.weights);
+        pass.frames.clear();
+        pass.frames.extend(self.bodies.orientation.iter().map(|q| {
+            let r = q.to_rotation_matrix();
+            let m = r.matrix();
+            [m.column(2).into_owned(), m.column(0).into_owned(), m.column(1).into_owned()]
+        }));
         for i in 0..n {
             if !self.alive[i] {
                 continue;
@@ -282,7 +308,7 @@ impl RigidScene {
                         clump_plane_contacts(&plane, clump, &pose, &mut contacts);
                     }
                     (None | Some((PreparedShape::Plane { .. }, _)), RigidShape::Revolution(r)) => {
-                        let body = placed(r, &pose);
+                        let body = placed_with(r, pose.position, &pass.frames[i]);
                         if plane_normal.dot(&(pose.position - plane_point)) < r.bounding_radius {
                             plane_contacts(
                                 &plane_point,
@@ -385,8 +411,8 @@ impl RigidScene {
             {
                 match (shape_a, shape_b) {
                     (RigidShape::Revolution(ra), RigidShape::Revolution(rb)) => pair_contacts(
-                        &placed(ra, &pa),
-                        &placed(rb, &pb),
+                        &placed_with(ra, pa.position, &pass.frames[a]),
+                        &placed_with(rb, pb.position, &pass.frames[b]),
                         &mut pass.pair_scratch,
                         &mut contacts,
                         &mut weights,
@@ -517,10 +543,9 @@ fn polygon_contacts(
         return;
     }
     let to_na = |v: &crate::geometry::Vec3| Vector3::new(v.x, v.y, v.z);
-    let world: Vec<V3> = vertices.iter().map(|v| to_na(v) + offset).collect();
-    let inward: Vec<V3> = edge_normals.iter().map(to_na).collect();
+    let first = to_na(&vertices[0]) + offset;
     let mut n = to_na(&normal);
-    let side = n.dot(&(pose.position - world[0]));
+    let side = n.dot(&(pose.position - first));
     if side.abs() >= shape.bounding_radius {
         return;
     }
@@ -529,12 +554,14 @@ fn polygon_contacts(
     }
     let body = placed(shape, pose);
     let inside = |x: &V3| {
-        world
+        vertices
             .iter()
-            .zip(&inward)
-            .all(|(v, e)| e.dot(&(x - v)) >= 0.0)
+            .zip(edge_normals)
+            .all(|(v, e)| to_na(e).dot(&(x - to_na(v) - offset)) >= 0.0)
     };
-    plane_contacts(&world[0], &n, &body, Some(&inside), contacts, weights);
+    plane_contacts(&first, &n, &body, Some(&inside), contacts, weights);
+    let world: Vec<V3> = vertices.iter().map(|v| to_na(v) + offset).collect();
+    let inward: Vec<V3> = edge_normals.iter().map(to_na).collect();
     polygon_edge_contacts(&world, &inward, &body, contacts, weights);
 }
 
