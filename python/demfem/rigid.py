@@ -1,7 +1,9 @@
 """Full-shape cartridges: numpy in, numpy out, around the Rust engine ``RigidSimulation``.
 
 A cartridge is a rigid body — a clump of beads (``Cartridge.bead_clump``, 632 beads as in the
-paper) or the exact body of revolution as parry3d convex pieces (``Cartridge.stations``) —
+paper), the exact body of revolution as parry3d convex pieces (``Cartridge.stations``,
+particle ``"cylinder"``) or the same body of revolution with analytic contact tests (particle
+``"revolution"``, the fast exact shape: frustums, edge circles and faces) —
 with Hertz + Tsuji normal contacts and Mindlin–Coulomb friction, on a belt between plane and
 polygon walls (the table's gate moves harmonically). Positions are centres of mass (m);
 orientations are quaternions (w, x, y, z) of the cartridge frame (axis z, bottom to top);
@@ -37,23 +39,26 @@ __all__ = [
     "run",
 ]
 
-#: Particle kinds this module builds ("cylinder" is the exact parry shape).
-FULL_SHAPES = ("clump", "cylinder")
+#: Particle kinds this module builds ("cylinder" is the exact parry shape, "revolution" the
+#: same body of revolution with analytic contact tests).
+FULL_SHAPES = ("clump", "cylinder", "revolution")
 
 
 def shape_dict(particle: str, cartridge: Optional[Cartridge] = None, n_beads: int = 632) -> dict[str, Any]:
     """The engine's shape dict of ``cartridge`` (default: the default cartridge): for
     ``"clump"`` its ``n_beads``-bead clump (centres (n, 3) m about the centre of mass, radii m,
-    masses kg), for ``"cylinder"`` its stations (z, r_in, r_out, m) as an exact shape."""
+    masses kg), for ``"cylinder"`` its stations (z, r_in, r_out, m) as an exact parry shape, for
+    ``"revolution"`` the same stations as the analytic body of revolution."""
     c = Cartridge() if cartridge is None else cartridge
     if particle == "clump":
         clump = c.bead_clump(n_beads)
         return {"kind": "clump", "centers": np.ascontiguousarray(clump.centers),
                 "radii": np.ascontiguousarray(clump.radii),
                 "masses": np.ascontiguousarray(clump.masses)}
-    if particle == "cylinder":
+    if particle in ("cylinder", "revolution"):
         z, r_in, r_out = c.stations()
-        return {"kind": "exact", "z": z, "r_in": r_in, "r_out": r_out}
+        kind = "exact" if particle == "cylinder" else "revolution"
+        return {"kind": kind, "z": z, "r_in": r_in, "r_out": r_out}
     raise InvalidParameterError(f"invalid particle = {particle!r}: must be one of {FULL_SHAPES}")
 
 
@@ -79,7 +84,7 @@ def from_scene(
     (:class:`demfem.scenes.table.SceneDescription`): each sphere becomes an upright
     cartridge at the sphere's (x, y) with its bottom ``lift`` (m) above the belt.
 
-    ``particle`` (``"clump"`` or ``"cylinder"``) defaults to the scene's own ``particle``
+    ``particle`` (one of :data:`FULL_SHAPES`) defaults to the scene's own ``particle``
     parameter. The cartridge (default :class:`demfem.cartridge.Cartridge`) must have the
     scene's particle mass at the scene's glass density, as the equivalent sphere does, so
     that spheres and full shapes carry the same mass. ``dt`` (s) defaults to the stable limit

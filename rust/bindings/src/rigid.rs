@@ -14,8 +14,8 @@ use pyo3::types::{PyDict, PyList};
 
 use demfem::geometry::Vec3;
 use demfem::rigid::{
-    BeadClump, ContactMaterial, ExactShape, RevolutionProfile, RigidScene, RigidSceneConfig,
-    RigidShape, RigidWall,
+    BeadClump, ContactMaterial, ExactShape, RevolutionProfile, RevolutionShape, RigidScene,
+    RigidSceneConfig, RigidShape, RigidWall,
 };
 use demfem::DemfemError;
 
@@ -32,6 +32,12 @@ const RIGID_EFFECTS: [&str; 6] = [
     "rotation",
     "damping",
 ];
+
+/// Overlap tolerated between bodies of revolution (or a body and a wall) at the start, m.
+const START_OVERLAP_TOLERANCE: f64 = 1e-9;
+
+/// The shape kinds `RigidSimulation` takes.
+const SHAPE_KINDS: &str = "'clump', 'exact' or 'revolution'";
 
 fn to_na(v: Vec3) -> Vector3<f64> {
     Vector3::new(v.x, v.y, v.z)
@@ -54,8 +60,10 @@ fn array_1d(field: &str, d: &Bound<'_, PyDict>, key: &str) -> PyResult<Vec<f64>>
     }
 }
 
-/// The shape dict: {"kind": "clump", "centers" (n, 3) m, "radii" (n,) m, "masses" (n,) kg}
-/// or {"kind": "exact", "z", "r_in", "r_out" (stations, m)} with the density of `material`.
+/// The shape dict: {"kind": "clump", "centers" (n, 3) m, "radii" (n,) m, "masses" (n,) kg},
+/// {"kind": "exact", "z", "r_in", "r_out" (stations, m)} (parry compound) or
+/// {"kind": "revolution", same stations} (the fast exact body of revolution), with the
+/// density of `material`.
 /// Returns the scene shape, its mass properties and the rotation from the principal (body)
 /// frame to the cartridge frame.
 fn parse_shape(
@@ -69,8 +77,8 @@ fn parse_shape(
     let kind: String = match d.get_item("kind")? {
         Some(k) => k
             .extract()
-            .map_err(|_| invalid("shape.kind", &k.to_string(), "'clump' or 'exact'"))?,
-        None => return Err(invalid("shape.kind", "missing", "'clump' or 'exact'")),
+            .map_err(|_| invalid("shape.kind", &k.to_string(), SHAPE_KINDS))?,
+        None => return Err(invalid("shape.kind", "missing", SHAPE_KINDS)),
     };
     match kind.as_str() {
         "clump" => {
@@ -97,7 +105,7 @@ fn parse_shape(
             let frame = clump.principal_frame;
             Ok((RigidShape::Clump(clump), mass, frame))
         }
-        "exact" => {
+        "exact" | "revolution" => {
             let profile = RevolutionProfile::new(
                 array_1d("shape", d, "z")?,
                 array_1d("shape", d, "r_in")?,
@@ -107,11 +115,20 @@ fn parse_shape(
             let mass = profile
                 .mass_properties(density)
                 .map_err(PyDemfemError::from)?;
-            let shape = ExactShape::from_profile(&profile, mass.center_of_mass.z)
-                .map_err(PyDemfemError::from)?;
-            Ok((RigidShape::Exact(shape), mass, UnitQuaternion::identity()))
+            let shape = if kind == "exact" {
+                RigidShape::Exact(
+                    ExactShape::from_profile(&profile, mass.center_of_mass.z)
+                        .map_err(PyDemfemError::from)?,
+                )
+            } else {
+                RigidShape::Revolution(
+                    RevolutionShape::from_profile(&profile, mass.center_of_mass.z)
+                        .map_err(PyDemfemError::from)?,
+                )
+            };
+            Ok((shape, mass, UnitQuaternion::identity()))
         }
-        other => Err(invalid("shape.kind", other, "'clump' or 'exact'")),
+        other => Err(invalid("shape.kind", other, SHAPE_KINDS)),
     }
 }
 
@@ -302,6 +319,11 @@ impl RigidSimulation {
                 )
                 .map_err(PyDemfemError::from)?;
         }
+        // bodies of revolution must not start overlapping (the check evaluates the forces
+        // as the first step would)
+        scene
+            .check_start_overlaps(START_OVERLAP_TOLERANCE)
+            .map_err(PyDemfemError::from)?;
         let _ = py;
         Ok(RigidSimulation {
             scene,
