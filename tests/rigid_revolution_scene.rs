@@ -196,3 +196,32 @@ fn packed_cartridges_on_a_belt_run_bitwise_the_same_on_1_2_and_3_threads() {
         assert!(same, "{threads} threads differ from 1");
     }
 }
+
+/// Every onset logs where it touched: an upright cartridge dropped on the belt touches with
+/// its bottom rim (the point a body-frame height −z_c, on the rim circle), normal +z, no
+/// partner pose; the same through the parry shape.
+#[test]
+fn onsets_log_the_contact_point_and_the_poses() {
+    for kind in ["revolution", "exact"] {
+        let config = RigidSceneConfig {
+            planes: vec![RigidSceneConfig::belt(Vector3::zeros()).unwrap()],
+            record_onsets: true,
+            ..Default::default()
+        };
+        let mut scene = RigidScene::new(config).unwrap();
+        let (shape, mass) = cartridge(kind);
+        let id = scene.add_shape(shape, mass).unwrap();
+        let zc = com_height();
+        scene
+            .add_body(id, Vector3::new(0.01, 0.0, zc + 1e-4), UnitQuaternion::identity(), Vector3::zeros(), Vector3::zeros())
+            .unwrap();
+        scene.run((0.01 / scene.time_step()) as u64).unwrap();
+        let o = scene.onsets()[0];
+        let local = o.body_pose.orientation.inverse_transform_vector(&(o.point - o.body_pose.position));
+        println!("{kind}: {o:?}");
+        assert!(o.partner_is_wall && o.partner_pose.is_none());
+        assert!((o.normal - Vector3::z()).norm() < 1e-12);
+        assert!((local.z + zc).abs() < 1e-5, "{kind}: height {}", local.z + zc);
+        assert!((local.x.hypot(local.y) - R_OUT).abs() < 1e-5, "{kind}: radius");
+    }
+}

@@ -33,6 +33,10 @@ from demfem.scenes.table import cartridge_sites
 __all__ = [
     "RigidSimulation",
     "FULL_SHAPES",
+    "PLACES",
+    "place_of",
+    "contact_places",
+    "at_place",
     "shape_dict",
     "upright",
     "from_scene",
@@ -60,6 +64,68 @@ def shape_dict(particle: str, cartridge: Optional[Cartridge] = None, n_beads: in
         kind = "exact" if particle == "cylinder" else "revolution"
         return {"kind": kind, "z": z, "r_in": r_in, "r_out": r_out}
     raise InvalidParameterError(f"invalid particle = {particle!r}: must be one of {FULL_SHAPES}")
+
+
+#: Places on a cartridge a contact can touch, bottom to top: the open end ("rim": within one
+#: wall thickness of it, its edge and its end face), the body, the shoulder (from the
+#: body–shoulder edge), the neck and the flange (its chamfer, side, edge and top).
+PLACES = ("rim", "body", "shoulder", "neck", "flange")
+
+
+def place_of(height: Any, cartridge: Optional[Cartridge] = None) -> np.ndarray:
+    """The place (one of :data:`PLACES`, "" where the height is NaN) of contact points at
+    ``height`` (m) along the cartridge axis from its open end."""
+    c = Cartridge() if cartridge is None else cartridge
+    h = np.asarray(height, float)
+    bounds = np.cumsum([c.body_length, c.shoulder_length, c.neck_length])
+    names = np.array(PLACES[1:], dtype=object)[np.searchsorted(bounds, h, side="right")]
+    names = np.where(h <= c.wall_thickness, "rim", names)
+    return np.where(np.isnan(h), "", names).astype(object)
+
+
+def contact_places(sim: RigidSimulation, cartridge: Optional[Cartridge] = None,
+                   walls: Optional[list[Any]] = None) -> dict[str, np.ndarray]:
+    """Every contact onset of ``sim`` with where it touched each body: ``sim.onsets()``
+    plus ``height_body`` and ``height_partner`` (m along the axis from the open end; NaN
+    for walls and spheres), ``place_body`` and ``place_partner`` (:data:`PLACES`, "" where
+    there is none), ``body_kind`` and ``partner_kind`` ("cartridge", "sphere" or "wall"),
+    ``axis_angle_deg`` (the angle between the two axes, or between the axis and a wall's
+    surface, degrees) and, with the scene's ``walls`` (dicts with a name, or names, in the
+    engine's order), ``partner_name`` (the wall's name, "" for bodies)."""
+    c = Cartridge() if cartridge is None else cartridge
+    events = dict(sim.onsets())
+    zc = float(c.center_of_mass[2])
+    is_sphere = np.asarray(sim.is_sphere(), bool)
+    body = np.asarray(events["body"], int)
+    partner = np.asarray(events["partner"], int)
+    wall = np.asarray(events["partner_is_wall"], bool)
+    for side, key in (("body", "point_body"), ("partner", "point_partner")):
+        height = np.asarray(events[key], float).reshape(-1, 3)[:, 2] + zc
+        events[f"height_{side}"] = height
+        events[f"place_{side}"] = place_of(height, c)
+    kinds = np.where(is_sphere, "sphere", "cartridge").astype(object)
+    events["body_kind"] = kinds[body] if len(body) else np.zeros(0, dtype=object)
+    partner_kind = np.full(len(partner), "wall", dtype=object)
+    bodies = ~wall
+    partner_kind[bodies] = kinds[partner[bodies]]
+    events["partner_kind"] = partner_kind
+    events["axis_angle_deg"] = np.degrees(np.asarray(events["axis_angle"], float))
+    if walls is not None:
+        names = [w["name"] if isinstance(w, dict) else str(w) for w in walls]
+        events["partner_name"] = np.array(
+            [names[p] if is_wall and p < len(names) else "" for p, is_wall in zip(partner, wall)],
+            dtype=object)
+    return events
+
+
+def at_place(events: dict[str, np.ndarray], place: str, side: str = "body") -> np.ndarray:
+    """Mask of the events of :func:`contact_places` that touched ``place`` (one of
+    :data:`PLACES`) on the ``side`` ("body" or "partner") body."""
+    if place not in PLACES:
+        raise InvalidParameterError(f"invalid place = {place!r}: must be one of {PLACES}")
+    if side not in ("body", "partner"):
+        raise InvalidParameterError(f"invalid side = {side!r}: must be 'body' or 'partner'")
+    return np.asarray(events[f"place_{side}"] == place, bool)
 
 
 def upright(n: int) -> np.ndarray:

@@ -491,52 +491,67 @@ impl RigidSimulation {
     }
 
     /// Every contact onset (first step of a new body–body or body–wall contact): time (s),
-    /// body, partner, partner_is_wall, normal_speed (> 0 approaching), tangential_speed (m/s).
+    /// body, partner, partner_is_wall, normal_speed (> 0 approaching), tangential_speed
+    /// (m/s), and where it touched (see `demfem._core.pyi`): point, normal, point_body,
+    /// point_partner (cartridge frames), axis_angle.
     fn onsets<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let o = self.scene.onsets();
         let d = PyDict::new(py);
+        macro_rules! column {
+            ($name:expr, $f:expr) => {
+                d.set_item($name, o.iter().map($f).collect::<Vec<_>>().into_pyarray(py))?;
+            };
+        }
+        column!("time", |x| x.time);
+        column!("body", |x| x.body);
+        column!("partner", |x| x.partner);
+        column!("partner_is_wall", |x| x.partner_is_wall);
+        column!("normal_speed", |x| x.normal_speed);
+        column!("tangential_speed", |x| x.tangential_speed);
+        let rows = |f: &dyn Fn(&demfem::rigid::RigidOnset) -> Vector3<f64>| -> Vec<Vec3> {
+            o.iter().map(|x| from_na(&f(x))).collect()
+        };
+        d.set_item("point", array_n3(py, &rows(&|x| x.point))?)?;
+        d.set_item("normal", array_n3(py, &rows(&|x| x.normal))?)?;
+        let nan = Vector3::repeat(f64::NAN);
+        // a world point in the cartridge frame of body i at the pose it had then
+        let local = |i: u32, pose: &demfem::rigid::BodyPose, p: &Vector3<f64>| {
+            if self.sphere.get(i as usize).copied().unwrap_or(true) {
+                nan
+            } else {
+                self.principal_frame * pose.orientation.inverse_transform_vector(&(p - pose.position))
+            }
+        };
+        let axis_of = |i: u32, pose: &demfem::rigid::BodyPose| {
+            if self.sphere.get(i as usize).copied().unwrap_or(true) {
+                nan
+            } else {
+                pose.orientation * self.principal_frame.inverse_transform_vector(&Vector3::z())
+            }
+        };
         d.set_item(
-            "time",
-            o.iter()
-                .map(|x| x.time)
-                .collect::<Vec<_>>()
-                .into_pyarray(py),
+            "point_body",
+            array_n3(py, &rows(&|x| local(x.body, &x.body_pose, &x.point)))?,
         )?;
         d.set_item(
-            "body",
-            o.iter()
-                .map(|x| x.body)
-                .collect::<Vec<_>>()
-                .into_pyarray(py),
+            "point_partner",
+            array_n3(
+                py,
+                &rows(&|x| match (&x.partner_pose, x.partner_is_wall) {
+                    (Some(pose), false) => local(x.partner, pose, &x.point),
+                    _ => nan,
+                }),
+            )?,
         )?;
-        d.set_item(
-            "partner",
-            o.iter()
-                .map(|x| x.partner)
-                .collect::<Vec<_>>()
-                .into_pyarray(py),
-        )?;
-        d.set_item(
-            "partner_is_wall",
-            o.iter()
-                .map(|x| x.partner_is_wall)
-                .collect::<Vec<_>>()
-                .into_pyarray(py),
-        )?;
-        d.set_item(
-            "normal_speed",
-            o.iter()
-                .map(|x| x.normal_speed)
-                .collect::<Vec<_>>()
-                .into_pyarray(py),
-        )?;
-        d.set_item(
-            "tangential_speed",
-            o.iter()
-                .map(|x| x.tangential_speed)
-                .collect::<Vec<_>>()
-                .into_pyarray(py),
-        )?;
+        column!("axis_angle", |x| {
+            let a = axis_of(x.body, &x.body_pose);
+            // (f64::min would drop the NaN of a sphere's axis)
+            let clamp = |c: f64| if c.is_nan() { c } else { c.abs().min(1.0) };
+            match (&x.partner_pose, x.partner_is_wall) {
+                (Some(pose), false) => clamp(a.dot(&axis_of(x.partner, pose))).acos(),
+                _ => clamp(a.dot(&x.normal)).asin(),
+            }
+        });
         Ok(d)
     }
 

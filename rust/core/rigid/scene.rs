@@ -92,7 +92,9 @@ pub struct RigidWall {
 }
 
 /// The first force evaluation of a new contact between a body and another body or a
-/// boundary (a pair counts as one contact however many beads or points touch).
+/// boundary (a pair counts as one contact however many beads or points touch), with where
+/// it touches: the deepest point and the poses of both bodies then, from which the contact's
+/// place on each body (its height along the axis) and the angle between the axes follow.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RigidOnset {
     /// Simulated time, s.
@@ -107,6 +109,15 @@ pub struct RigidOnset {
     pub normal_speed: f64,
     /// Tangential relative speed at that point, m/s.
     pub tangential_speed: f64,
+    /// The deepest contact point, world, m.
+    pub point: Vector3<f64>,
+    /// Unit contact normal there, world: from the wall to the body, or from `body` to
+    /// `partner`.
+    pub normal: Vector3<f64>,
+    /// Pose of `body` at the onset.
+    pub body_pose: BodyPose,
+    /// Pose of `partner` at the onset (`None` for a wall).
+    pub partner_pose: Option<BodyPose>,
 }
 
 /// A wall prepared for the contact pass.

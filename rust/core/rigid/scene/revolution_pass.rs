@@ -356,7 +356,11 @@ impl RigidScene {
                 if !pass.wall_touching[slot] && self.record_onsets {
                     let c0 = contacts[deepest];
                     let relative = self.bodies.point_velocity(i, &c0.point) - surface_velocity;
-                    self.onsets.push(onset(time, i, p, true, &relative, &c0.normal));
+                    let mut o = onset(time, i, p, true, &relative, &c0.normal);
+                    o.point = c0.point;
+                    o.normal = c0.normal;
+                    o.body_pose = pose;
+                    self.onsets.push(o);
                 }
                 pass.wall_touching[slot] = true;
                 let overlap = contacts[deepest].overlap;
@@ -449,7 +453,11 @@ impl RigidScene {
                 let relative = self.bodies.point_velocity(second, &c0.point)
                     - self.bodies.point_velocity(first, &c0.point);
                 let mut o = onset(time, a, b, false, &relative, &c0.normal);
-                o.partner = b as u32;
+                o.point = c0.point;
+                // logged from the lower index (a) to the higher
+                o.normal = if first == a { c0.normal } else { -c0.normal };
+                o.body_pose = pa;
+                o.partner_pose = Some(pb);
                 self.onsets.push(o);
             }
             pass.pair_touching[k] = true;
@@ -604,6 +612,13 @@ fn onset(time: f64, body: usize, partner: usize, wall: bool, relative: &V3, norm
         partner_is_wall: wall,
         normal_speed: -v_n,
         tangential_speed: (relative - normal * v_n).norm(),
+        point: Vector3::zeros(),
+        normal: *normal,
+        body_pose: BodyPose {
+            position: Vector3::zeros(),
+            orientation: UnitQuaternion::identity(),
+        },
+        partner_pose: None,
     }
 }
 
