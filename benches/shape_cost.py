@@ -44,7 +44,7 @@ def build(particle: str, table: str, young_modulus: float, threads: int) -> Any:
                                         young_modulus=young_modulus).build()
     if particle == "sphere":
         return dem.from_scene(description, model="hertz_mindlin", threads=threads)
-    return rigid.from_scene(description, particle=particle, record_onsets=False)
+    return rigid.from_scene(description, particle=particle, record_onsets=False, threads=threads)
 
 
 def main() -> None:
@@ -56,7 +56,8 @@ def main() -> None:
     p.add_argument("--warmup", type=float, default=0.3, help="untimed simulated time, s")
     p.add_argument("--window", type=float, default=0.1, help="timed simulated time per repeat, s")
     p.add_argument("--reps", type=int, default=5)
-    p.add_argument("--threads", type=int, default=1, help="threads of the sphere engine")
+    p.add_argument("--threads", type=int, default=1,
+                   help="threads of the sphere engine and of the bodies of revolution's geometry")
     p.add_argument("--json", default=None)
     a = p.parse_args()
     if "sphere" not in a.particles:

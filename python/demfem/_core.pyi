@@ -406,7 +406,8 @@ class RigidSimulation:
     removal_plane (point, normal to the kept side): bodies past it are removed. spheres (N,)
     bool flags bodies that are equivalent spheres of radius sphere_radius (m) and the
     cartridge's mass instead of cartridges (mixed tables); their orientation is that of the
-    ball, their axes and tilt angles NaN.
+    ball, their axes and tilt angles NaN. threads: the contact geometry of bodies of
+    revolution on that many threads (64 bodies or more), bitwise the same result.
     """
 
     def __new__(
@@ -428,6 +429,7 @@ class RigidSimulation:
         record_onsets: bool = False,
         spheres: Optional[npt.NDArray[np.bool_]] = None,
         sphere_radius: Optional[float] = None,
+        threads: int = 1,
     ) -> RigidSimulation: ...
     def step(self, n: int, chunk: int = 2000) -> None: ...
     def run_until(self, t_end: float, chunk: int = 2000) -> int: ...

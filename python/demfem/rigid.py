@@ -145,6 +145,7 @@ def from_scene(
     expected_max_speed: float = 1.0,
     record_onsets: bool = True,
     lift: float = 1e-6,
+    threads: int = 1,
 ) -> RigidSimulation:
     """Build the rigid engine from an engine-neutral scene description
     (:class:`demfem.scenes.table.SceneDescription`): each sphere becomes an upright
@@ -155,7 +156,9 @@ def from_scene(
     scene's particle mass at the scene's glass density, as the equivalent sphere does, so
     that spheres and full shapes carry the same mass. ``dt`` (s) defaults to the stable limit
     of the stiffest contact at ``expected_max_speed`` (m/s); a larger one is refused.
-    Bodies whose centre of mass crosses the scene's removal plane are removed.
+    Bodies whose centre of mass crosses the scene's removal plane are removed. ``threads``:
+    the contact geometry of bodies of revolution on that many threads (bitwise the same
+    result; tables of 64 bodies or more).
 
     Mixed tables (``cartridge_fraction < 1``, see
     :class:`demfem.scenes.table.AccumulationTable`): the sites that
@@ -204,7 +207,7 @@ def from_scene(
         gravity=(float(g[0]), float(g[1]), float(g[2])), dt=dt,
         expected_max_speed=expected_max_speed, removal_plane=removal_plane,
         record_onsets=record_onsets, spheres=spheres,
-        sphere_radius=None if spheres is None else float(radii[0]),
+        sphere_radius=None if spheres is None else float(radii[0]), threads=threads,
     )
 
 

@@ -149,7 +149,7 @@ impl RigidSimulation {
         positions, orientations, shape, material, walls, effects, *, velocities=None,
         angular_velocities=None, wall_material=None, gravity=(0.0, 0.0, -9.81), dt=None,
         expected_max_speed=1.0, removal_plane=None, record_onsets=false, spheres=None,
-        sphere_radius=None
+        sphere_radius=None, threads=1
     ))]
     #[allow(clippy::too_many_arguments)]
     fn new(
@@ -170,7 +170,12 @@ impl RigidSimulation {
         record_onsets: bool,
         spheres: Option<PyReadonlyArray1<'_, bool>>,
         sphere_radius: Option<f64>,
+        threads: i64,
     ) -> PyResult<Self> {
+        let threads = usize::try_from(threads)
+            .ok()
+            .filter(|&t| t >= 1)
+            .ok_or_else(|| invalid("threads", &threads.to_string(), "a whole number >= 1"))?;
         for e in &effects {
             if !RIGID_EFFECTS.contains(&e.as_str()) {
                 return Err(PyDemfemError::from(DemfemError::Effect(format!(
@@ -244,6 +249,7 @@ impl RigidSimulation {
             removal_plane: removal_plane
                 .map(|(p, n)| (Vector3::new(p.0, p.1, p.2), Vector3::new(n.0, n.1, n.2))),
             record_onsets,
+            threads,
         };
         let mut scene = RigidScene::new(config).map_err(PyDemfemError::from)?;
         let sphere: Vec<bool> = match &spheres {

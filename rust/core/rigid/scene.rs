@@ -39,6 +39,7 @@ use crate::error::{check_positive, DemfemError, Result};
 use crate::geometry::{MeshWall, WallMotion, WallShape};
 
 mod contacts;
+mod revolution_geometry;
 mod revolution_pass;
 
 use contacts::FrictionHistory;
@@ -76,6 +77,9 @@ pub struct RigidSceneConfig {
     pub removal_plane: Option<(Vector3<f64>, Vector3<f64>)>,
     /// Log the first step of every new contact ([`RigidOnset`]).
     pub record_onsets: bool,
+    /// Threads of the contact geometry of bodies of revolution (≥ 1); the result is bitwise
+    /// the same on any number.
+    pub threads: usize,
 }
 
 /// A wall of a rigid scene: a plane or a convex polygon of [`crate::geometry`], translated
@@ -200,6 +204,7 @@ impl Default for RigidSceneConfig {
             walls: Vec::new(),
             removal_plane: None,
             record_onsets: false,
+            threads: 1,
         }
     }
 }
@@ -250,6 +255,8 @@ pub struct RigidScene {
     wall_contacts: Vec<u32>,
     /// The contact pass of scenes with bodies of revolution (`None` without them).
     revolution: Option<revolution_pass::RevolutionPass>,
+    /// The threads of that pass (`None`: one).
+    pool: Option<rayon::ThreadPool>,
 }
 
 impl RigidScene {
@@ -262,6 +269,21 @@ impl RigidScene {
             });
         }
         check_positive("max_expected_speed", config.max_expected_speed)?;
+        if config.threads == 0 {
+            return Err(DemfemError::invalid("threads", 0.0, "a whole number >= 1"));
+        }
+        let pool = if config.threads > 1 {
+            Some(
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(config.threads)
+                    .build()
+                    .map_err(|e| {
+                        DemfemError::Numerical(format!("cannot start {} threads: {e}", config.threads))
+                    })?,
+            )
+        } else {
+            None
+        };
         if let Some(dt) = config.time_step {
             check_positive("time_step", dt)?;
         }
@@ -324,6 +346,7 @@ impl RigidScene {
             coordination: Vec::new(),
             wall_contacts: Vec::new(),
             revolution: None,
+            pool,
         })
     }
 
