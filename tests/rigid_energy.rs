@@ -278,7 +278,11 @@ fn damped_pile_of_revolution_cartridges_never_gains_energy() {
             worst_rise / e0,
             scene.contacts_last_step()
         );
-        assert!(worst_rise < 1e-3 * e0, "seed {seed}: rose by {:e} E0", worst_rise / e0);
+        assert!(
+            worst_rise < 1e-3 * e0,
+            "seed {seed}: rose by {:e} E0",
+            worst_rise / e0
+        );
         assert!(vmax < 2.3, "speed {vmax} m/s");
         assert!(last.1 < 0.2 * e0, "seed {seed}: the pile did not settle");
     }
@@ -431,4 +435,3 @@ fn crossed(kind: &str) {
         );
     }
 }
-

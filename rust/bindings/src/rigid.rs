@@ -525,7 +525,10 @@ impl RigidSimulation {
             if self.sphere.get(i as usize).copied().unwrap_or(true) {
                 nan
             } else {
-                self.principal_frame * pose.orientation.inverse_transform_vector(&(p - pose.position))
+                self.principal_frame
+                    * pose
+                        .orientation
+                        .inverse_transform_vector(&(p - pose.position))
             }
         };
         let axis_of = |i: u32, pose: &demfem::rigid::BodyPose| {

@@ -180,10 +180,13 @@ impl RigidBodies {
     /// closed form (two rotations per step instead of the splitting's five). Refused unless
     /// its transverse moments are equal, I_x = I_y (a body of revolution about z).
     pub fn set_symmetric_top(&mut self, i: usize, on: bool) -> Result<()> {
-        let inertia = self.principal_inertia.get(i).ok_or_else(|| DemfemError::ShapeMismatch {
-            field: "body".into(),
-            detail: format!("{i} but only {} bodies exist", self.len()),
-        })?;
+        let inertia = self
+            .principal_inertia
+            .get(i)
+            .ok_or_else(|| DemfemError::ShapeMismatch {
+                field: "body".into(),
+                detail: format!("{i} but only {} bodies exist", self.len()),
+            })?;
         if on && inertia.x != inertia.y {
             return Err(DemfemError::ShapeMismatch {
                 field: "principal_inertia".into(),
@@ -231,7 +234,11 @@ impl RigidBodies {
         // precession: about the fixed L by |L| h / I_t
         let half = 0.5 * size * h / it;
         let (sh, ch) = half.sin_cos();
-        let axis = if size > 0.0 { world / size } else { Vector3::zeros() };
+        let axis = if size > 0.0 {
+            world / size
+        } else {
+            Vector3::zeros()
+        };
         let space = nalgebra::Quaternion::from_parts(ch, axis * sh);
         // spin relative to the precession: about body z by c h
         let beta = (1.0 / iz - 1.0 / it) * momentum.z * h;
@@ -321,7 +328,10 @@ mod tests {
             split.drift(1e-4);
         }
         let drift = exact.kinetic_energy(0) / e0 - 1.0;
-        println!("KE drift {drift:e}, L drift {:e}", (exact.angular_momentum_world(0) - l0).norm() / l0.norm());
+        println!(
+            "KE drift {drift:e}, L drift {:e}",
+            (exact.angular_momentum_world(0) - l0).norm() / l0.norm()
+        );
         assert!(drift.abs() < 1e-12, "{drift:e}");
         assert!((exact.angular_momentum_world(0) - l0).norm() < 1e-11 * l0.norm());
         // the splitting is second order: the two agree to its error, O((ω h)²)

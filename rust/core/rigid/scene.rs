@@ -278,7 +278,10 @@ impl RigidScene {
                     .num_threads(config.threads)
                     .build()
                     .map_err(|e| {
-                        DemfemError::Numerical(format!("cannot start {} threads: {e}", config.threads))
+                        DemfemError::Numerical(format!(
+                            "cannot start {} threads: {e}",
+                            config.threads
+                        ))
                     })?,
             )
         } else {

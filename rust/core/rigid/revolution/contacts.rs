@@ -39,7 +39,9 @@
 
 use nalgebra::Vector3;
 
-use super::features::{piece_pair_cached, segment_parameters, CandidateCache, Feature, FeaturePair, Placed};
+use super::features::{
+    piece_pair_cached, segment_parameters, CandidateCache, Feature, FeaturePair, Placed,
+};
 use crate::rigid::collision::ContactPoint;
 
 type V3 = Vector3<f64>;
@@ -113,7 +115,14 @@ pub fn line_pair(a: &Rod, b: &Rod) -> (f64, f64, f64) {
 
 /// The two end samples of a line pair of weight `gh` over [α, β] = [`lo`, `hi`] with the
 /// deepest point at `sigma` along `a` (`None`: halfway).
-pub fn line_samples(a: &Rod, b: &Rod, gh: f64, lo: f64, hi: f64, sigma: Option<f64>) -> [LineSample; 2] {
+pub fn line_samples(
+    a: &Rod,
+    b: &Rod,
+    gh: f64,
+    lo: f64,
+    hi: f64,
+    sigma: Option<f64>,
+) -> [LineSample; 2] {
     let ell = hi - lo;
     let s = sigma.unwrap_or(0.5 * (lo + hi)).clamp(lo, hi);
     let shares = [(s - lo) / ell, (hi - s) / ell];
@@ -187,12 +196,8 @@ fn near_pieces(x: &Placed, y: &Placed, out: &mut Vec<(usize, Rod)>) {
     let (c0, c1) = (y.at(capsule.z_min), y.at(capsule.z_max));
     for (i, f) in x.shape.frustums.iter().enumerate() {
         let rod = piece_rod(x, i);
-        let (s, t, _) = segment_parameters(
-            &rod.start,
-            &(rod.direction * rod.length),
-            &c0,
-            &(c1 - c0),
-        );
+        let (s, t, _) =
+            segment_parameters(&rod.start, &(rod.direction * rod.length), &c0, &(c1 - c0));
         let gap = rod.start + rod.direction * (s * rod.length) - c0 - (c1 - c0) * t;
         if gap.norm() < f.reach + capsule.radius {
             out.push((i, rod));
@@ -267,9 +272,9 @@ pub fn pair_contacts(
             continue;
         }
         let owned = own
-            || scratch.found[k + 1..].iter().any(|e| {
-                e.3 && e.0.feature_a == f.feature_a && e.0.feature_b == f.feature_b
-            });
+            || scratch.found[k + 1..]
+                .iter()
+                .any(|e| e.3 && e.0.feature_a == f.feature_a && e.0.feature_b == f.feature_b);
         let weight = if owned {
             1.0
         } else {
@@ -335,7 +340,14 @@ pub fn pair_contacts(
 /// of the circle at quarter turns anchored at its deepest point along the face normal, as on
 /// a plane (so that two cartridges end to end press rim on rim evenly), each kept where it
 /// overlaps the face, projects onto it and lies in X's piece; appended oriented X → Y.
-fn face_points(x: &Placed, face: usize, piece: usize, y: &Placed, edge: usize, out: &mut Vec<ContactPoint>) {
+fn face_points(
+    x: &Placed,
+    face: usize,
+    piece: usize,
+    y: &Placed,
+    edge: usize,
+    out: &mut Vec<ContactPoint>,
+) {
     let f = x.shape.faces[face];
     let circle = y.shape.circles[edge];
     let m = x.axis * f.facing;
@@ -451,8 +463,7 @@ pub fn bead_contact(centre: &V3, radius: f64, body: &Placed) -> Option<ContactPo
         .position(|w| {
             let (ez, er) = (w[1].0 - w[0].0, w[1].1 - w[0].1);
             let (dz, dr) = (q.0 - w[0].0, q.1 - w[0].1);
-            (ez * dr - er * dz).abs() <= 1e-12 * (ez.abs() + er.abs())
-                && dz * ez + dr * er >= 0.0
+            (ez * dr - er * dz).abs() <= 1e-12 * (ez.abs() + er.abs()) && dz * ez + dr * er >= 0.0
         })
         .unwrap_or(0);
     Some(ContactPoint {

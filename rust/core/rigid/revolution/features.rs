@@ -137,8 +137,16 @@ pub fn segment_parameters(p0: &V3, d1: &V3, q0: &V3, d2: &V3) -> (f64, f64, bool
     let denom = a * e - b * b;
     let tiny = 1e-30;
     if a <= tiny || e <= tiny {
-        let s = if a <= tiny { 0.0 } else { (-c / a).clamp(0.0, 1.0) };
-        let t = if e <= tiny { 0.0 } else { (f / e).clamp(0.0, 1.0) };
+        let s = if a <= tiny {
+            0.0
+        } else {
+            (-c / a).clamp(0.0, 1.0)
+        };
+        let t = if e <= tiny {
+            0.0
+        } else {
+            (f / e).clamp(0.0, 1.0)
+        };
         return (s, t, false);
     }
     let raw_s = if denom > 1e-14 * a * e {
@@ -217,9 +225,8 @@ pub fn sweep_closest(a: &Sweep, b: &Sweep) -> Option<(f64, f64)> {
         return interior.then_some((sigma, tau));
     }
     let (ka, kb) = (a.k, b.k);
-    let f_of = |sg: f64, ta: f64| -> f64 {
-        (w + ua * sg - ub * ta).norm() - a.radius(sg) - b.radius(ta)
-    };
+    let f_of =
+        |sg: f64, ta: f64| -> f64 { (w + ua * sg - ub * ta).norm() - a.radius(sg) - b.radius(ta) };
     let scale = (sa1 - sa0).max(sb1 - sb0);
     for _ in 0..40 {
         let d = w + ua * sigma - ub * tau;
@@ -312,7 +319,16 @@ fn rotate(u: Turn, t: f64) -> Turn {
 /// The eight sample directions of a circle search, 45° apart.
 const SAMPLES: [Turn; 8] = {
     let r = std::f64::consts::FRAC_1_SQRT_2;
-    [(1.0, 0.0), (r, r), (0.0, 1.0), (-r, r), (-1.0, 0.0), (-r, -r), (0.0, -1.0), (r, -r)]
+    [
+        (1.0, 0.0),
+        (r, r),
+        (0.0, 1.0),
+        (-r, r),
+        (-1.0, 0.0),
+        (-r, -r),
+        (0.0, -1.0),
+        (r, -r),
+    ]
 };
 
 /// Minimum over the circle of a smooth function of the direction u = (cos θ, sin θ), given
@@ -345,7 +361,11 @@ pub fn circle_minimum(start: Option<Turn>, f: impl Fn(f64, f64) -> (f64, f64, f6
                 break;
             }
             let inside = |w: Turn| cross2(lo, w) > 0.0 && cross2(w, hi) > 0.0;
-            let newton = if d2 > 0.0 { Some(rotate(u, -d1 / d2)) } else { None };
+            let newton = if d2 > 0.0 {
+                Some(rotate(u, -d1 / d2))
+            } else {
+                None
+            };
             let next = match newton {
                 Some(w) if inside(w) => w,
                 _ => {
@@ -553,7 +573,11 @@ pub fn face_circle(x: &Placed, f: usize, y: &Placed, l: usize) -> Option<Feature
     let face_centre = x.at(face.z);
     let in_plane = m - y.axis * m.dot(&y.axis);
     let length = in_plane.norm();
-    let direction = if length > 1e-12 { in_plane / length } else { y.x };
+    let direction = if length > 1e-12 {
+        in_plane / length
+    } else {
+        y.x
+    };
     let p = y.at(circle.z) - direction * circle.r;
     let distance = m.dot(&(p - face_centre));
     let (_, _, rho) = x.meridian(&p);
@@ -660,7 +684,8 @@ pub fn piece_pair_cached(
     // in contact mode (margin 0) the first valid overlap ends the search: between shallowly
     // overlapping convex pieces one feature pair is valid (two only where a contact passes
     // from one to the next, at the same point)
-    let settled = |best: &Option<FeaturePair>| margin <= 0.0 && best.is_some_and(|b| b.distance < 0.0);
+    let settled =
+        |best: &Option<FeaturePair>| margin <= 0.0 && best.is_some_and(|b| b.distance < 0.0);
     let consider = |c: Option<FeaturePair>, best: &mut Option<FeaturePair>| {
         if let Some(c) = c {
             // an overlap is real only where each closest point lies in the other piece (a
@@ -678,7 +703,10 @@ pub fn piece_pair_cached(
     for &k in fa.circles.iter().filter(|k| convex_a(k)) {
         let c = a.shape.circles[k];
         if !settled(&best) && distance_to_piece_axis(b, j, &a.at(c.z)) < c.r + fb.reach + margin {
-            consider(cache.solve(Edge(k), Side(j), || circle_side(a, k, b, j)), &mut best);
+            consider(
+                cache.solve(Edge(k), Side(j), || circle_side(a, k, b, j)),
+                &mut best,
+            );
         }
     }
     for &l in fb.circles.iter().filter(|l| convex_b(l)) {
@@ -694,14 +722,20 @@ pub fn piece_pair_cached(
         for &l in fb.circles.iter().filter(|l| convex_b(l)) {
             let (ck, cl) = (a.shape.circles[k], b.shape.circles[l]);
             if !settled(&best) && (a.at(ck.z) - b.at(cl.z)).norm() < ck.r + cl.r + margin {
-                consider(cache.solve(Edge(k), Edge(l), || circle_circle(a, k, b, l)), &mut best);
+                consider(
+                    cache.solve(Edge(k), Edge(l), || circle_circle(a, k, b, l)),
+                    &mut best,
+                );
             }
         }
     }
     for &f in fa.faces.iter().flatten() {
         for &l in fb.circles.iter().filter(|l| convex_b(l)) {
             if !settled(&best) {
-                consider(cache.solve(Face(f), Edge(l), || face_circle(a, f, b, l)), &mut best);
+                consider(
+                    cache.solve(Face(f), Edge(l), || face_circle(a, f, b, l)),
+                    &mut best,
+                );
             }
         }
     }

@@ -353,12 +353,7 @@ impl RevolutionShape {
         // the Hertz radius: the local radius on a side or edge, the outer radius on a face
         let (a, b) = (self.outline[k], self.outline[k + 1]);
         let radius = if a.0 == b.0 { a.1.max(b.1) } else { q.1 };
-        (
-            if inside { -distance } else { distance },
-            q,
-            normal,
-            radius,
-        )
+        (if inside { -distance } else { distance }, q, normal, radius)
     }
 
     /// Whether the point (z, ρ) of the meridian half-plane lies inside the solid.

@@ -39,11 +39,21 @@ type Candidate = (f64, V3, V3, V3, Feature);
 /// Edge circle `k` of the body against the segment `start + u t`, u ∈ (0, length):
 /// (distance, normal body → wall, point on the circle, point on the segment), `None` unless
 /// the foot is inside the segment and the normal in the circle's cone.
-fn circle_segment(x: &Placed, k: usize, start: &V3, t: &V3, length: f64) -> Option<(f64, V3, V3, V3)> {
+fn circle_segment(
+    x: &Placed,
+    k: usize,
+    start: &V3,
+    t: &V3,
+    length: f64,
+) -> Option<(f64, V3, V3, V3)> {
     let circle = x.shape.circles[k];
     let q0 = x.at(circle.z) - start;
     let r = circle.r;
-    let (a0, ac, as_) = (q0.norm_squared() + r * r, 2.0 * r * q0.dot(&x.x), 2.0 * r * q0.dot(&x.y));
+    let (a0, ac, as_) = (
+        q0.norm_squared() + r * r,
+        2.0 * r * q0.dot(&x.x),
+        2.0 * r * q0.dot(&x.y),
+    );
     let (b0, bc, bs) = (q0.dot(t), r * x.x.dot(t), r * x.y.dot(t));
     let eval = |c: f64, s: f64| -> (f64, f64, f64) {
         let av = a0 + ac * c + as_ * s;
@@ -122,7 +132,13 @@ fn edge_piece(body: &Placed, i: usize, rod: &Rod, inward: &[V3]) -> Option<Candi
         if length > 1e-15 {
             let u = d / length;
             let radius = sweep.radius(sigma);
-            consider((length - radius, u, on_edge, centre - u * radius, Feature::Side(i)));
+            consider((
+                length - radius,
+                u,
+                on_edge,
+                centre - u * radius,
+                Feature::Side(i),
+            ));
         }
     }
     for &k in &body.shape.frustums[i].circles {
@@ -232,7 +248,9 @@ pub fn edge_contacts(
         let piece = piece_rod(body, i);
         for sample in line_samples(&piece, &rod, gh, lo, hi, sigma) {
             // the sample's normal runs from the body to the edge
-            if sample.overlap > 0.0 && sample.weight > 0.0 && off_every_face(&(-sample.normal), inward)
+            if sample.overlap > 0.0
+                && sample.weight > 0.0
+                && off_every_face(&(-sample.normal), inward)
             {
                 out.push(ContactPoint {
                     point: sample.point,
@@ -306,10 +324,25 @@ pub fn polygon_edge_contacts(
     let n = vertices.len();
     for e in 0..n {
         let (va, vb) = (vertices[e], vertices[(e + 1) % n]);
-        edge_contacts(&va, &vb, &edge_normals[e..e + 1], EDGE_KEY + e as u64, body, out, weights);
+        edge_contacts(
+            &va,
+            &vb,
+            &edge_normals[e..e + 1],
+            EDGE_KEY + e as u64,
+            body,
+            out,
+            weights,
+        );
     }
     for m in 0..n {
         let neighbours = [vertices[(m + 1) % n], vertices[(m + n - 1) % n]];
-        corner_contact(&vertices[m], &neighbours, CORNER_KEY + m as u64, body, out, weights);
+        corner_contact(
+            &vertices[m],
+            &neighbours,
+            CORNER_KEY + m as u64,
+            body,
+            out,
+            weights,
+        );
     }
 }

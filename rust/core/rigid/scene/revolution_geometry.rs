@@ -13,7 +13,9 @@ use crate::rigid::collision::{
     clump_clump_contacts, clump_mesh_contacts, clump_plane_contacts, clump_polygon_contacts,
     BodyPose, ClumpPairScratch, ContactPoint, Plane,
 };
-use crate::rigid::revolution::contacts::{bead_contact, pair_contacts, plane_contacts, PairScratch};
+use crate::rigid::revolution::contacts::{
+    bead_contact, pair_contacts, plane_contacts, PairScratch,
+};
 use crate::rigid::revolution::features::Placed;
 use crate::rigid::revolution::wall_edges::polygon_edge_contacts;
 use crate::rigid::shape::{MassProperties, RigidShape};
@@ -87,7 +89,11 @@ pub(super) fn frames(orientations: &[UnitQuaternion<f64>], out: &mut Vec<[V3; 3]
     out.extend(orientations.iter().map(|q| {
         let r = q.to_rotation_matrix();
         let m = r.matrix();
-        [m.column(2).into_owned(), m.column(0).into_owned(), m.column(1).into_owned()]
+        [
+            m.column(2).into_owned(),
+            m.column(0).into_owned(),
+            m.column(1).into_owned(),
+        ]
     }));
 }
 
@@ -163,7 +169,12 @@ impl View<'_> {
                         PreparedShape::Plane { point, normal } => (point + offset, *normal),
                         _ => (offset, Vector3::z()),
                     };
-                    (point, normal, wall.surface_velocity + velocity, Some((wall, offset)))
+                    (
+                        point,
+                        normal,
+                        wall.surface_velocity + velocity,
+                        Some((wall, offset)),
+                    )
                 };
                 let contacts = &mut block.contacts;
                 let weights = &mut block.weights;
@@ -180,13 +191,23 @@ impl View<'_> {
                     (None | Some((PreparedShape::Plane { .. }, _)), RigidShape::Revolution(r)) => {
                         if plane_normal.dot(&(pose.position - plane_point)) < r.bounding_radius {
                             let body = placed_with(r, pose.position, &frames[i]);
-                            plane_contacts(&plane_point, &plane_normal, &body, None, contacts, weights);
+                            plane_contacts(
+                                &plane_point,
+                                &plane_normal,
+                                &body,
+                                None,
+                                contacts,
+                                weights,
+                            );
                         }
                     }
                     (Some((PreparedShape::Polygon(polygon), offset)), RigidShape::Clump(clump)) => {
                         clump_polygon_contacts(polygon, &offset, clump, &pose, contacts)
                     }
-                    (Some((PreparedShape::Polygon(polygon), offset)), RigidShape::Revolution(r)) => {
+                    (
+                        Some((PreparedShape::Polygon(polygon), offset)),
+                        RigidShape::Revolution(r),
+                    ) => {
                         polygon_contacts(polygon, &offset, r, &pose, &frames[i], contacts, weights);
                     }
                     (Some((PreparedShape::Mesh(mesh), offset)), RigidShape::Clump(clump)) => {
@@ -326,7 +347,9 @@ fn beads_against(
     body: &Placed,
     contacts: &mut Vec<ContactPoint>,
 ) {
-    let local = pose.orientation.inverse_transform_vector(&(body.origin - pose.position));
+    let local = pose
+        .orientation
+        .inverse_transform_vector(&(body.origin - pose.position));
     for (k, (c, &r)) in clump.centers.iter().zip(&clump.radii).enumerate() {
         if (c - local).norm() >= body.shape.bounding_radius + r {
             continue;

@@ -65,8 +65,6 @@ impl RevolutionPass {
     }
 }
 
-
-
 /// A body's bounding capsule inflated by half the skin, and the box around it: (lower x,
 /// upper x, lower corner, upper corner, axis start, axis end, radius, body).
 type CapsuleBox = (f64, f64, V3, V3, V3, V3, f64, u32);
@@ -246,7 +244,11 @@ impl RigidScene {
             view.wall_geometry(cut(n, b), frames_now, &offsets, walls)?;
             view.pair_geometry(pairs, cut(pairs.len(), b), frames_now, pair)
         };
-        let jobs = pass.wall_blocks.iter_mut().zip(pass.pair_blocks.iter_mut()).enumerate();
+        let jobs = pass
+            .wall_blocks
+            .iter_mut()
+            .zip(pass.pair_blocks.iter_mut())
+            .enumerate();
         match (&self.pool, blocks) {
             (Some(pool), b) if b > 1 => pool.install(|| {
                 use rayon::prelude::*;
@@ -302,8 +304,7 @@ impl RigidScene {
                 }
                 for (c, &w) in contacts.iter().zip(weights) {
                     max_overlap = max_overlap.max(c.overlap);
-                    let relative =
-                        self.bodies.point_velocity(i, &c.point) - touch.surface_velocity;
+                    let relative = self.bodies.point_velocity(i, &c.point) - touch.surface_velocity;
                     let (f, energy) = self.spring_force(
                         pass,
                         old,
@@ -416,13 +417,12 @@ impl RigidScene {
             .model
             .force_and_energy(c, relative, m_star, e_star, &mut xi, dt)?;
         if with_history {
-            pass.springs_next.push((c.feature_first, c.feature_second, xi));
+            pass.springs_next
+                .push((c.feature_first, c.feature_second, xi));
         }
         Ok(out)
     }
 }
-
-
 
 fn deepest_of(contacts: &[ContactPoint]) -> usize {
     let mut deepest = 0;
@@ -434,7 +434,14 @@ fn deepest_of(contacts: &[ContactPoint]) -> usize {
     deepest
 }
 
-fn onset(time: f64, body: usize, partner: usize, wall: bool, relative: &V3, normal: &V3) -> RigidOnset {
+fn onset(
+    time: f64,
+    body: usize,
+    partner: usize,
+    wall: bool,
+    relative: &V3,
+    normal: &V3,
+) -> RigidOnset {
     let v_n = relative.dot(normal);
     RigidOnset {
         time,
@@ -452,4 +459,3 @@ fn onset(time: f64, body: usize, partner: usize, wall: bool, relative: &V3, norm
         partner_pose: None,
     }
 }
-
