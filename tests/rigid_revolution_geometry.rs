@@ -96,7 +96,11 @@ impl SupportMap for FrustumSupport {
     fn local_support_point(&self, dir: Vector) -> Vector {
         let radial = Vector::new(dir.x, dir.y, 0.0);
         let length = radial.length();
-        let unit = if length > 0.0 { radial / length } else { Vector::X };
+        let unit = if length > 0.0 {
+            radial / length
+        } else {
+            Vector::X
+        };
         let candidate = |k: usize| unit * self.r[k] + Vector::new(0.0, 0.0, self.z[k]);
         let (a, b) = (candidate(0), candidate(1));
         if a.dot(dir) >= b.dot(dir) {
@@ -275,7 +279,8 @@ fn tubes_match_parry_cylinders_on_random_poses() {
         }
         let frame_a = pose_of(&xa, &(qa * y_to_z));
         let frame_b = pose_of(&xb, &(qb * y_to_z));
-        let Some(c) = contact_support_map_support_map(&frame_a.inv_mul(&frame_b), &cyl_a, &cyl_b, 1.0)
+        let Some(c) =
+            contact_support_map_support_map(&frame_a.inv_mul(&frame_b), &cyl_a, &cyl_b, 1.0)
         else {
             panic!("parry found no contact at {xa:?} {xb:?}");
         };
@@ -312,8 +317,14 @@ fn tubes_match_parry_cylinders_on_random_poses() {
         "tube–tube, {} poses ({penetrating} overlapping, {separated} apart, {trials} drawn): certified to {:.3e} m; max |Δd| against parry {:.3e} m (|Δ depth| against EPA {epa_gap:.3e} m; ours above GJK by at most {above_parry:.3e} m, our depth above the overlap along EPA's normal by at most {below_epa:.3e} m); with unique closest points ({}): max normal angle {:.3e} rad, max point distance {:.3e} m; {}",
         worst.compared, worst.certificate, worst.distance, worst.points_compared, worst.normal, worst.point, worst.spread()
     );
-    assert!(above_parry <= 1e-12, "above GJK's upper bound by {above_parry:e}");
-    assert!(below_epa <= 1e-12, "depth above the overlap along EPA's normal by {below_epa:e}");
+    assert!(
+        above_parry <= 1e-12,
+        "above GJK's upper bound by {above_parry:e}"
+    );
+    assert!(
+        below_epa <= 1e-12,
+        "depth above the overlap along EPA's normal by {below_epa:e}"
+    );
     assert!(worst.certificate <= 1e-12);
 }
 
@@ -360,14 +371,21 @@ fn cartridges_apart_match_exact_frustums_on_random_poses() {
         for i in 0..n {
             for j in 0..n {
                 let mut bound = f64::NEG_INFINITY;
-                if let Some(c) = contact_support_map_support_map(&pos12, &supports[i], &supports[j], 1.0) {
+                if let Some(c) =
+                    contact_support_map_support_map(&pos12, &supports[i], &supports[j], 1.0)
+                {
                     let normal = from_parry(fa.rotation * c.normal1);
                     if c.dist <= 0.0 {
                         overlapping = true;
                     }
                     bound = bound.max(best_separation(&a, i, &b, j, &normal));
                     if reference.is_none_or(|r| c.dist < r.0) {
-                        reference = Some((c.dist, normal, from_parry(fa * c.point1), from_parry(fb * c.point2)));
+                        reference = Some((
+                            c.dist,
+                            normal,
+                            from_parry(fa * c.point1),
+                            from_parry(fb * c.point2),
+                        ));
                     }
                 }
                 if let Some(f) = piece_pair_within(&a, i, &b, j, 1.0) {
@@ -443,7 +461,10 @@ fn cartridge_deviates_from_parrys_compound_by_its_polygon_cones() {
         }
         compared += 1;
         worst = worst.max((mine.distance - d).abs());
-        let sides = matches!((mine.feature_a, mine.feature_b), (Feature::Side(_), Feature::Side(_)));
+        let sides = matches!(
+            (mine.feature_a, mine.feature_b),
+            (Feature::Side(_), Feature::Side(_))
+        );
         if sides && shape.frustums[i].is_cylinder() && shape.frustums[j].is_cylinder() {
             worst_cylinders = worst_cylinders.max((mine.distance - d).abs());
         }
@@ -470,11 +491,19 @@ fn tube_on_a_plane_and_beads_match_parry() {
         let x = V3::new(0.0, 0.0, rng.next() * 0.03);
         let body = placed(&shape, &x, &q);
         let (mut out, mut weights) = (Vec::new(), Vec::new());
-        plane_contacts(&V3::zeros(), &floor_normal, &body, None, &mut out, &mut weights);
+        plane_contacts(
+            &V3::zeros(),
+            &floor_normal,
+            &body,
+            None,
+            &mut out,
+            &mut weights,
+        );
         // the deepest point of the body below z = 0: the lowest support point
         let lowest = {
             let frame = pose_of(&x, &(q * y_to_z));
-            let support = cyl.local_support_point(frame.rotation.inverse() * Vector::new(0.0, 0.0, -1.0));
+            let support =
+                cyl.local_support_point(frame.rotation.inverse() * Vector::new(0.0, 0.0, -1.0));
             from_parry(frame * support).z
         };
         let deepest = out.iter().map(|c| c.overlap).fold(0.0, f64::max);
@@ -486,7 +515,8 @@ fn tube_on_a_plane_and_beads_match_parry() {
         // a bead of 2 mm near the body
         let centre = x + rng.in_ball(0.035);
         let ball = Ball::new(2e-3);
-        let pos12 = pose_of(&centre, &UnitQuaternion::identity()).inv_mul(&pose_of(&x, &(q * y_to_z)));
+        let pos12 =
+            pose_of(&centre, &UnitQuaternion::identity()).inv_mul(&pose_of(&x, &(q * y_to_z)));
         let reference = contact_support_map_support_map(&pos12, &ball, &cyl, 1.0);
         let mine = bead_contact(&centre, 2e-3, &body);
         match (reference, mine) {
@@ -494,7 +524,10 @@ fn tube_on_a_plane_and_beads_match_parry() {
                 worst_bead = worst_bead.max((m.overlap + c.dist).abs());
             }
             (Some(c), None) => assert!(c.dist >= -1e-12, "missed a bead overlap {}", c.dist),
-            (Some(c), Some(m)) => panic!("bead overlap {} where parry has distance {}", m.overlap, c.dist),
+            (Some(c), Some(m)) => panic!(
+                "bead overlap {} where parry has distance {}",
+                m.overlap, c.dist
+            ),
             _ => {}
         }
         compared += 1;

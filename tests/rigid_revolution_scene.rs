@@ -5,8 +5,7 @@ mod rigid_common;
 
 use demfem::geometry::{Vec3, WallMotion, WallShape};
 use demfem::rigid::{
-    Plane, RevolutionProfile, RevolutionShape, RigidScene, RigidSceneConfig, RigidShape,
-    RigidWall,
+    Plane, RevolutionProfile, RevolutionShape, RigidScene, RigidSceneConfig, RigidShape, RigidWall,
 };
 use demfem::DemfemError;
 use nalgebra::{UnitQuaternion, Vector3};
@@ -23,23 +22,41 @@ fn field_of(e: DemfemError) -> String {
 
 #[test]
 fn profiles_that_are_not_bodies_of_revolution_are_refused_naming_the_field() {
-    let ok = || (vec![0.0, 0.05, 0.06], vec![4e-3, 4e-3, 2e-3], vec![5e-3, 5e-3, 3e-3]);
+    let ok = || {
+        (
+            vec![0.0, 0.05, 0.06],
+            vec![4e-3, 4e-3, 2e-3],
+            vec![5e-3, 5e-3, 3e-3],
+        )
+    };
     let (z, ri, ro) = ok();
     assert!(RevolutionProfile::new(z, ri, ro).is_ok());
     // an outer radius of zero, a negative bore, the bore as wide as the glass
     let (z, ri, mut ro) = ok();
     ro[1] = 0.0;
-    assert_eq!(field_of(RevolutionProfile::new(z, ri, ro).unwrap_err()), "r_out");
+    assert_eq!(
+        field_of(RevolutionProfile::new(z, ri, ro).unwrap_err()),
+        "r_out"
+    );
     let (z, mut ri, ro) = ok();
     ri[0] = -1e-3;
-    assert_eq!(field_of(RevolutionProfile::new(z, ri, ro).unwrap_err()), "r_in");
+    assert_eq!(
+        field_of(RevolutionProfile::new(z, ri, ro).unwrap_err()),
+        "r_in"
+    );
     let (z, mut ri, ro) = ok();
     ri[2] = 3e-3;
-    assert_eq!(field_of(RevolutionProfile::new(z, ri, ro).unwrap_err()), "r_in");
+    assert_eq!(
+        field_of(RevolutionProfile::new(z, ri, ro).unwrap_err()),
+        "r_in"
+    );
     // heights going back down, or not rising at all
     let (mut z, ri, ro) = ok();
     z[2] = 0.04;
-    assert_eq!(field_of(RevolutionProfile::new(z, ri, ro).unwrap_err()), "z");
+    assert_eq!(
+        field_of(RevolutionProfile::new(z, ri, ro).unwrap_err()),
+        "z"
+    );
     let e = RevolutionProfile::new(vec![0.0, 0.0], vec![1e-3; 2], vec![2e-3; 2]).unwrap_err();
     assert_eq!(field_of(e), "z");
     // a centre of mass that is not a number, too many stations
@@ -49,7 +66,10 @@ fn profiles_that_are_not_bodies_of_revolution_are_refused_naming_the_field() {
     let n = 300;
     let z: Vec<f64> = (0..n).map(|k| k as f64 * 1e-4).collect();
     let p = RevolutionProfile::new(z, vec![1e-3; n], vec![2e-3; n]).unwrap();
-    assert_eq!(field_of(RevolutionShape::from_profile(&p, 0.0).unwrap_err()), "stations");
+    assert_eq!(
+        field_of(RevolutionShape::from_profile(&p, 0.0).unwrap_err()),
+        "stations"
+    );
     // a scene takes revolution shapes with clumps, not with parry's exact shapes
     let mut scene = RigidScene::new(RigidSceneConfig::default()).unwrap();
     let (shape, mass) = cartridge("revolution");
@@ -99,30 +119,32 @@ fn overlapping_start_poses_are_refused_naming_the_bodies() {
 /// Outer radius of the body, m.
 const R_OUT: f64 = 5.8e-3;
 
-/// 24 cartridges, upright in a 6 × 4 block 0.2 mm apart with small random tilts, on a belt
+/// 72 cartridges, upright in a 12 × 6 block 0.2 mm apart with small random tilts, on a belt
 /// moving at 0.2 m/s towards a gate (a vertical polygon oscillating across the belt) between
-/// two side walls, with one clump-sphere among them; `steps` steps in a pool of `threads`
-/// threads. Returns the final state and the largest overlap seen.
+/// two side walls, with one clump-sphere among them; `steps` steps with the contact
+/// geometry on `threads` threads. Returns the final state and the largest overlap seen.
 fn packed_run(threads: usize, steps: u64) -> (Vec<f64>, f64) {
     let walls = vec![
         RigidWall {
-            shape: WallShape::plane(Vec3::new(0.0, -0.027, 0.0), Vec3::Y).unwrap(),
+            shape: WallShape::plane(Vec3::new(0.0, -0.039, 0.0), Vec3::Y).unwrap(),
             motion: WallMotion::Fixed,
             surface_velocity: Vector3::zeros(),
         },
         RigidWall {
-            shape: WallShape::plane(Vec3::new(0.0, 0.027, 0.0), -Vec3::Y).unwrap(),
+            shape: WallShape::plane(Vec3::new(0.0, 0.039, 0.0), -Vec3::Y).unwrap(),
             motion: WallMotion::Fixed,
             surface_velocity: Vector3::zeros(),
         },
         RigidWall {
-            shape: WallShape::vertical_strip(0.075, -0.03, 0.075, 0.01, 0.0, 0.07).unwrap(),
+            shape: WallShape::vertical_strip(0.146, -0.04, 0.146, 0.01, 0.0, 0.07).unwrap(),
             motion: WallMotion::harmonic(Vec3::Y, 0.01, 0.05, 0.0).unwrap(),
             surface_velocity: Vector3::zeros(),
         },
     ];
     let config = RigidSceneConfig {
-        planes: vec![Plane::new(Vector3::zeros(), Vector3::z(), Vector3::new(0.2, 0.0, 0.0)).unwrap()],
+        planes: vec![
+            Plane::new(Vector3::zeros(), Vector3::z(), Vector3::new(0.2, 0.0, 0.0)).unwrap(),
+        ],
         walls,
         body_material: demfem::rigid::ContactMaterial {
             young_modulus: 45e8,
@@ -131,6 +153,7 @@ fn packed_run(threads: usize, steps: u64) -> (Vec<f64>, f64) {
         restitution: 0.5,
         friction: 0.2,
         max_expected_speed: 1.0,
+        threads,
         ..Default::default()
     };
     let mut scene = RigidScene::new(config).unwrap();
@@ -148,30 +171,39 @@ fn packed_run(threads: usize, steps: u64) -> (Vec<f64>, f64) {
         (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
     };
     let pitch = 2.0 * R_OUT + 2e-4;
-    for k in 0..24 {
-        let (i, j) = (k % 6, k / 6);
+    for k in 0..72 {
+        let (i, j) = (k % 12, k / 12);
         let x = i as f64 * pitch;
-        let y = (j as f64 - 1.5) * pitch;
+        let y = (j as f64 - 2.5) * pitch;
         if k == 9 {
             scene
-                .add_body(bead_id, Vector3::new(x, y, R_OUT + 1e-6), UnitQuaternion::identity(), Vector3::zeros(), Vector3::zeros())
+                .add_body(
+                    bead_id,
+                    Vector3::new(x, y, R_OUT + 1e-6),
+                    UnitQuaternion::identity(),
+                    Vector3::zeros(),
+                    Vector3::zeros(),
+                )
                 .unwrap();
             continue;
         }
         let tilt = UnitQuaternion::from_euler_angles(0.002 * next(), 0.002 * next(), 3.0 * next());
         scene
-            .add_body(id, Vector3::new(x, y, zc + 2e-5), tilt, Vector3::zeros(), Vector3::zeros())
+            .add_body(
+                id,
+                Vector3::new(x, y, zc + 2e-5),
+                tilt,
+                Vector3::zeros(),
+                Vector3::zeros(),
+            )
             .unwrap();
     }
     scene.check_start_overlaps(1e-9).unwrap();
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
     let mut largest: f64 = 0.0;
-    pool.install(|| {
-        for _ in 0..steps / 100 {
-            scene.run(100).unwrap();
-            largest = largest.max(scene.max_overlap_last_step());
-        }
-    });
+    for _ in 0..steps / 100 {
+        scene.run(100).unwrap();
+        largest = largest.max(scene.max_overlap_last_step());
+    }
     let b = &scene.bodies;
     let mut state = Vec::new();
     for i in 0..b.len() {
@@ -185,14 +217,62 @@ fn packed_run(threads: usize, steps: u64) -> (Vec<f64>, f64) {
 
 #[test]
 fn packed_cartridges_on_a_belt_run_bitwise_the_same_on_1_2_and_3_threads() {
-    let steps = 20_000;
+    let steps = 10_000;
     let (one, largest) = packed_run(1, steps);
     println!("packed block, {steps} steps: largest overlap {largest:e} m");
     assert!(one.iter().all(|v| v.is_finite()));
     assert!(largest < 1e-5, "overlap {largest:e} m");
     for threads in [2, 3] {
         let (other, _) = packed_run(threads, steps);
-        let same = one.iter().zip(&other).all(|(a, b)| a.to_bits() == b.to_bits());
+        let same = one
+            .iter()
+            .zip(&other)
+            .all(|(a, b)| a.to_bits() == b.to_bits());
         assert!(same, "{threads} threads differ from 1");
+    }
+}
+
+/// Every onset logs where it touched: an upright cartridge dropped on the belt touches with
+/// its bottom rim (the point a body-frame height −z_c, on the rim circle), normal +z, no
+/// partner pose; the same through the parry shape.
+#[test]
+fn onsets_log_the_contact_point_and_the_poses() {
+    for kind in ["revolution", "exact"] {
+        let config = RigidSceneConfig {
+            planes: vec![RigidSceneConfig::belt(Vector3::zeros()).unwrap()],
+            record_onsets: true,
+            ..Default::default()
+        };
+        let mut scene = RigidScene::new(config).unwrap();
+        let (shape, mass) = cartridge(kind);
+        let id = scene.add_shape(shape, mass).unwrap();
+        let zc = com_height();
+        scene
+            .add_body(
+                id,
+                Vector3::new(0.01, 0.0, zc + 1e-4),
+                UnitQuaternion::identity(),
+                Vector3::zeros(),
+                Vector3::zeros(),
+            )
+            .unwrap();
+        scene.run((0.01 / scene.time_step()) as u64).unwrap();
+        let o = scene.onsets()[0];
+        let local = o
+            .body_pose
+            .orientation
+            .inverse_transform_vector(&(o.point - o.body_pose.position));
+        println!("{kind}: {o:?}");
+        assert!(o.partner_is_wall && o.partner_pose.is_none());
+        assert!((o.normal - Vector3::z()).norm() < 1e-12);
+        assert!(
+            (local.z + zc).abs() < 1e-5,
+            "{kind}: height {}",
+            local.z + zc
+        );
+        assert!(
+            (local.x.hypot(local.y) - R_OUT).abs() < 1e-5,
+            "{kind}: radius"
+        );
     }
 }

@@ -406,21 +406,25 @@ class FemShellSolver:
 
 @final
 class RigidSimulation:
-    """Rigid cartridges (bead clumps or exact parry shapes) on a belt between walls.
+    """Rigid cartridges (bead clumps, exact parry shapes or bodies of revolution) on a belt
+    between walls.
 
     positions (N, 3) centres of mass, m; orientations (N, 4) quaternions (w, x, y, z) of the
     cartridge frame (axis z); shape: {'kind': 'clump', 'centers' (n, 3) m, 'radii' (n,) m,
-    'masses' (n,) kg} or {'kind': 'exact', 'z', 'r_in', 'r_out'} (stations, m; mass from the
-    material's density); material: dict with young_modulus (Pa), poisson_ratio, density
-    (kg/m^3), friction, restitution; walls: 'plane', 'polygon' or 'mesh' (bead clumps
-    only; not rotating) dicts as for DemSimulation
+    'masses' (n,) kg}, {'kind': 'exact', 'z', 'r_in', 'r_out'} (stations, m; mass from the
+    material's density; parry compound) or {'kind': 'revolution', same stations} (analytic
+    body of revolution; overlapping start poses are refused); material: dict with
+    young_modulus (Pa), poisson_ratio, density (kg/m^3), friction, restitution; walls:
+    'plane', 'polygon' or 'mesh' (clumps and bodies of revolution; not rotating) dicts as
+    for DemSimulation
     (surface_velocity, motion); effects: names from gravity, belt, moving_walls, friction,
     rotation, damping. angular_velocities in the world frame (rad/s). dt (s) defaults to the
     stable limit at expected_max_speed (m/s); a larger one raises UnstableTimeStepError.
     removal_plane (point, normal to the kept side): bodies past it are removed. spheres (N,)
     bool flags bodies that are equivalent spheres of radius sphere_radius (m) and the
     cartridge's mass instead of cartridges (mixed tables); their orientation is that of the
-    ball, their axes and tilt angles NaN.
+    ball, their axes and tilt angles NaN. threads: the contact geometry of bodies of
+    revolution on that many threads (64 bodies or more), bitwise the same result.
     """
 
     def __new__(
@@ -442,6 +446,7 @@ class RigidSimulation:
         record_onsets: bool = False,
         spheres: Optional[npt.NDArray[np.bool_]] = None,
         sphere_radius: Optional[float] = None,
+        threads: int = 1,
     ) -> RigidSimulation: ...
     def step(self, n: int, chunk: int = 2000) -> None: ...
     def run_until(self, t_end: float, chunk: int = 2000) -> int: ...
@@ -471,5 +476,13 @@ class RigidSimulation:
     def max_overlap(self) -> float: ...
     def contact_points(self) -> int: ...
     def remove_body(self, i: int) -> None: ...
-    def onsets(self) -> dict[str, npt.NDArray[Any]]: ...
+    def onsets(self) -> dict[str, npt.NDArray[Any]]:
+        """Every contact onset: time (s), body, partner, partner_is_wall, normal_speed,
+        tangential_speed (m/s), point (N, 3) the deepest contact point (world, m), normal
+        (N, 3) (from the wall to the body, or from body to partner), point_body and
+        point_partner (N, 3) that point in the cartridge frame of body and partner (m, origin
+        at the centre of mass, axis z; NaN for walls and spheres), axis_angle (rad): between
+        the two cartridge axes (0 to pi/2), against a wall between the axis and the wall's
+        surface (0: lying along it, pi/2: standing on it); NaN with a sphere."""
+        ...
     def clear_records(self) -> None: ...

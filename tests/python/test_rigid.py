@@ -16,7 +16,7 @@ BELT = dem.plane((0, 0, 0), (0, 0, 1))
 EFFECTS = ["gravity", "friction", "rotation", "damping"]
 
 
-@pytest.mark.parametrize("particle", ["clump", "cylinder"])
+@pytest.mark.parametrize("particle", ["clump", "cylinder", "revolution"])
 def test_dropped_cartridge_comes_to_rest_upright(particle):
     c = Cartridge()
     zc = float(c.center_of_mass[2])
@@ -77,7 +77,7 @@ def _small_table(**kw):
                              opening_width=0.03, gate_amplitude=0.01, wall_height=0.07, **kw)
 
 
-@pytest.mark.parametrize("particle", ["clump", "cylinder"])
+@pytest.mark.parametrize("particle", ["clump", "cylinder", "revolution"])
 def test_table_particle_builds_without_overlaps_and_runs(particle):
     description = _small_table(particle=particle).build()
     assert description.parameters["particle"] == particle
@@ -108,7 +108,7 @@ def test_table_particle_validation(tmp_path: Path):
     assert AccumulationTable.from_toml(path) == table
 
 
-@pytest.mark.parametrize("particle", ["clump", "cylinder"])
+@pytest.mark.parametrize("particle", ["clump", "cylinder", "revolution"])
 def test_belt_friction_topples_a_cartridge_only_above_r_over_zc(particle):
     # A belt starting under an upright cartridge drags its bottom with mu m g while it slips;
     # the weight can resist that torque about the centre of mass only up to m g r_out, so
@@ -130,7 +130,7 @@ def test_belt_friction_topples_a_cartridge_only_above_r_over_zc(particle):
 
 
 @pytest.mark.parametrize("particle,fraction", [("cylinder", 0.5), ("clump", 0.25),
-                                               ("cylinder", 0.0)])
+                                               ("cylinder", 0.0), ("revolution", 0.5)])
 def test_mixed_table_builds_counts_and_runs(particle, fraction):
     from demfem.scenes.table import cartridge_sites
 
@@ -188,6 +188,48 @@ def test_sphere_meets_cartridge_with_momentum_conserved():
     assert sim.velocities()[1, 2] == pytest.approx(-0.05, abs=0.01)
     assert sim.velocities()[0, 2] == pytest.approx(-0.15, abs=0.01)
     assert sim.kinetic_energy() / e0 == pytest.approx(0.625, abs=0.03)
+
+
+@pytest.mark.parametrize("particle", ["cylinder", "revolution"])
+def test_sphere_meets_either_exact_cartridge_alike(particle):
+    # the same side-on hit as above through the parry shape and the body of revolution: the
+    # two exact cartridges give the same outcome (both are exact on the body cylinder)
+    c = Cartridge()
+    r = c.equivalent_sphere().radius
+    lying = np.array([[math.cos(math.pi / 4), math.sin(math.pi / 4), 0.0, 0.0],
+                      [1.0, 0.0, 0.0, 0.0]])
+    x = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 0.5 * c.body_outer_diameter + r + 1e-5]])
+    v = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, -0.2]])
+    sim = rigid.RigidSimulation(x, lying, rigid.shape_dict(particle), GLASS, [],
+                                ["friction", "rotation", "damping"], velocities=v,
+                                spheres=np.array([False, True]), sphere_radius=r)
+    sim.run_until(2e-3)
+    assert sim.velocities()[1, 2] == pytest.approx(-0.05, abs=0.01)
+    assert sim.velocities()[0, 2] == pytest.approx(-0.15, abs=0.01)
+
+
+def test_revolution_shape_refuses_bad_profiles_and_overlapping_starts():
+    c = Cartridge()
+    zc = float(c.center_of_mass[2])
+    x = np.array([[0.0, 0.0, zc + 1e-6]])
+    good = rigid.shape_dict("revolution")
+    assert good["kind"] == "revolution"
+    for key, value, field in [("r_out", lambda r: np.where(np.arange(len(r)) == 1, 0.0, r), "r_out"),
+                              ("r_in", lambda r: r + 1.0, "r_in"),
+                              ("z", lambda z: z[::-1], "z")]:
+        bad = dict(good)
+        bad[key] = value(np.asarray(good[key], float))
+        with pytest.raises(InvalidParameterError, match=field):
+            rigid.RigidSimulation(x, rigid.upright(1), bad, GLASS, [BELT], EFFECTS)
+    # two cartridges 1 µm closer than touching side by side: refused, naming the bodies
+    d = c.body_outer_diameter
+    two = np.array([[0.0, 0.0, zc + 1e-6], [d - 1e-6, 0.0, zc + 1e-6]])
+    with pytest.raises(InvalidParameterError, match="positions.*bodies 0 and 1"):
+        rigid.RigidSimulation(two, rigid.upright(2), good, GLASS, [BELT], EFFECTS)
+    # through the belt: refused, naming the wall
+    with pytest.raises(InvalidParameterError, match="positions.*body 0 and wall 0"):
+        rigid.RigidSimulation(np.array([[0.0, 0.0, zc - 1e-4]]), rigid.upright(1), good, GLASS,
+                              [BELT], EFFECTS)
 
 
 def test_mixed_table_validation(tmp_path: Path):

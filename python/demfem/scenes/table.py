@@ -96,7 +96,7 @@ __all__ = [
 ]
 
 #: Particle kinds of the table: equivalent spheres, bead clumps, exact cartridge shapes.
-PARTICLES = ("sphere", "clump", "cylinder")
+PARTICLES = ("sphere", "clump", "cylinder", "revolution")
 
 #: Contact laws of the equivalent spheres a table scene may name (``contact_model``; see
 #: :func:`demfem.dem.from_scene`).
@@ -153,13 +153,15 @@ class AccumulationTable:
         packing_gap: gap between neighbouring spheres at t = 0, as a fraction of the diameter.
         particle: what stands at each start site: ``"sphere"`` (the equivalent sphere, run by
             :func:`demfem.dem.from_scene`), ``"clump"`` (the default cartridge as a rigid clump
-            of beads) or ``"cylinder"`` (the default cartridge as an exact parry shape), both
-            upright on the belt at the sphere's (x, y) and run by
+            of beads), ``"cylinder"`` (the default cartridge as an exact parry shape) or
+            ``"revolution"`` (the same exact cartridge as a body of revolution with analytic
+            contact tests: the fast full shape), all upright on the belt at the sphere's
+            (x, y) and run by
             :func:`demfem.rigid.from_scene`. Full shapes need ``wall_height`` at least the
             cartridge length (an upright cartridge must not lean over the walls) and cannot
             run ``planar``.
         cartridge_fraction: mixed tables: the fraction of start sites, in [0, 1], that hold
-            a cartridge of the shape named by ``particle`` (``"clump"`` or ``"cylinder"``); the
+            a cartridge of the shape named by ``particle`` (not ``"sphere"``); the
             other sites hold equivalent spheres, and both run together in the rigid engine
             (:func:`demfem.rigid.from_scene`). Which sites: :func:`cartridge_sites` — exactly
             round(n f) of them, spread evenly over the site order (deterministic, no seed).
@@ -315,8 +317,8 @@ class AccumulationTable:
         if self.particle == "sphere" and self.cartridge_fraction != 1.0:
             raise InvalidParameterError(
                 f"invalid cartridge_fraction = {self.cartridge_fraction!r} with particle = "
-                "'sphere': the fraction of sites holding cartridges needs particle = 'clump' "
-                "or 'cylinder' (the cartridge shape); with spheres it must be 1")
+                "'sphere': the fraction of sites holding cartridges needs particle = 'clump', "
+                "'cylinder' or 'revolution' (the cartridge shape); with spheres it must be 1")
         if self.particle != "sphere":
             length = self.cartridge.length
             _explained(check_range, "wall_height", self.wall_height, length, inf,
@@ -731,7 +733,8 @@ _UNITS: dict[str, str] = {
     "planar": "keep centres in one layer (effect planar)",
     "refeed": "re-insert removed spheres upstream",
     "packing_gap": "gap between start neighbours, fraction of the diameter",
-    "particle": "sphere, clump (632-bead cartridge) or cylinder (exact cartridge)",
+    "particle": "sphere, clump (632-bead cartridge), cylinder (exact cartridge, parry) or "
+                "revolution (exact cartridge, analytic: the fast full shape)",
     "cartridge_fraction": "fraction of sites with a cartridge of shape particle, in [0, 1]; "
                           "the rest are equivalent spheres",
 }

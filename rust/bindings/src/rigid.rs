@@ -14,8 +14,8 @@ use pyo3::types::{PyDict, PyList};
 
 use demfem::geometry::Vec3;
 use demfem::rigid::{
-    BeadClump, ContactMaterial, ExactShape, RevolutionProfile, RigidScene, RigidSceneConfig,
-    RigidShape, RigidWall,
+    BeadClump, ContactMaterial, ExactShape, RevolutionProfile, RevolutionShape, RigidScene,
+    RigidSceneConfig, RigidShape, RigidWall,
 };
 use demfem::DemfemError;
 
@@ -33,6 +33,12 @@ const RIGID_EFFECTS: [&str; 6] = [
     "rotation",
     "damping",
 ];
+
+/// Overlap tolerated between bodies of revolution (or a body and a wall) at the start, m.
+const START_OVERLAP_TOLERANCE: f64 = 1e-9;
+
+/// The shape kinds `RigidSimulation` takes.
+const SHAPE_KINDS: &str = "'clump', 'exact' or 'revolution'";
 
 fn to_na(v: Vec3) -> Vector3<f64> {
     Vector3::new(v.x, v.y, v.z)
@@ -55,8 +61,10 @@ fn array_1d(field: &str, d: &Bound<'_, PyDict>, key: &str) -> PyResult<Vec<f64>>
     }
 }
 
-/// The shape dict: {"kind": "clump", "centers" (n, 3) m, "radii" (n,) m, "masses" (n,) kg}
-/// or {"kind": "exact", "z", "r_in", "r_out" (stations, m)} with the density of `material`.
+/// The shape dict: {"kind": "clump", "centers" (n, 3) m, "radii" (n,) m, "masses" (n,) kg},
+/// {"kind": "exact", "z", "r_in", "r_out" (stations, m)} (parry compound) or
+/// {"kind": "revolution", same stations} (the fast exact body of revolution), with the
+/// density of `material`.
 /// Returns the scene shape, its mass properties and the rotation from the principal (body)
 /// frame to the cartridge frame.
 fn parse_shape(
@@ -70,8 +78,8 @@ fn parse_shape(
     let kind: String = match d.get_item("kind")? {
         Some(k) => k
             .extract()
-            .map_err(|_| invalid("shape.kind", &k.to_string(), "'clump' or 'exact'"))?,
-        None => return Err(invalid("shape.kind", "missing", "'clump' or 'exact'")),
+            .map_err(|_| invalid("shape.kind", &k.to_string(), SHAPE_KINDS))?,
+        None => return Err(invalid("shape.kind", "missing", SHAPE_KINDS)),
     };
     match kind.as_str() {
         "clump" => {
@@ -98,7 +106,7 @@ fn parse_shape(
             let frame = clump.principal_frame;
             Ok((RigidShape::Clump(clump), mass, frame))
         }
-        "exact" => {
+        "exact" | "revolution" => {
             let profile = RevolutionProfile::new(
                 array_1d("shape", d, "z")?,
                 array_1d("shape", d, "r_in")?,
@@ -108,11 +116,20 @@ fn parse_shape(
             let mass = profile
                 .mass_properties(density)
                 .map_err(PyDemfemError::from)?;
-            let shape = ExactShape::from_profile(&profile, mass.center_of_mass.z)
-                .map_err(PyDemfemError::from)?;
-            Ok((RigidShape::Exact(shape), mass, UnitQuaternion::identity()))
+            let shape = if kind == "exact" {
+                RigidShape::Exact(
+                    ExactShape::from_profile(&profile, mass.center_of_mass.z)
+                        .map_err(PyDemfemError::from)?,
+                )
+            } else {
+                RigidShape::Revolution(
+                    RevolutionShape::from_profile(&profile, mass.center_of_mass.z)
+                        .map_err(PyDemfemError::from)?,
+                )
+            };
+            Ok((shape, mass, UnitQuaternion::identity()))
         }
-        other => Err(invalid("shape.kind", other, "'clump' or 'exact'")),
+        other => Err(invalid("shape.kind", other, SHAPE_KINDS)),
     }
 }
 
@@ -133,7 +150,7 @@ impl RigidSimulation {
         positions, orientations, shape, material, walls, effects, *, velocities=None,
         angular_velocities=None, wall_material=None, gravity=(0.0, 0.0, -9.81), dt=None,
         expected_max_speed=1.0, removal_plane=None, record_onsets=false, spheres=None,
-        sphere_radius=None
+        sphere_radius=None, threads=1
     ))]
     #[allow(clippy::too_many_arguments)]
     fn new(
@@ -154,7 +171,12 @@ impl RigidSimulation {
         record_onsets: bool,
         spheres: Option<PyReadonlyArray1<'_, bool>>,
         sphere_radius: Option<f64>,
+        threads: i64,
     ) -> PyResult<Self> {
+        let threads = usize::try_from(threads)
+            .ok()
+            .filter(|&t| t >= 1)
+            .ok_or_else(|| invalid("threads", &threads.to_string(), "a whole number >= 1"))?;
         for e in &effects {
             if !RIGID_EFFECTS.contains(&e.as_str()) {
                 return Err(PyDemfemError::from(DemfemError::Effect(format!(
@@ -228,6 +250,7 @@ impl RigidSimulation {
             removal_plane: removal_plane
                 .map(|(p, n)| (Vector3::new(p.0, p.1, p.2), Vector3::new(n.0, n.1, n.2))),
             record_onsets,
+            threads,
         };
         let mut scene = RigidScene::new(config).map_err(PyDemfemError::from)?;
         let sphere: Vec<bool> = match &spheres {
@@ -303,6 +326,11 @@ impl RigidSimulation {
                 )
                 .map_err(PyDemfemError::from)?;
         }
+        // bodies of revolution must not start overlapping (the check evaluates the forces
+        // as the first step would)
+        scene
+            .check_start_overlaps(START_OVERLAP_TOLERANCE)
+            .map_err(PyDemfemError::from)?;
         let _ = py;
         Ok(RigidSimulation {
             scene,
@@ -469,52 +497,70 @@ impl RigidSimulation {
     }
 
     /// Every contact onset (first step of a new body–body or body–wall contact): time (s),
-    /// body, partner, partner_is_wall, normal_speed (> 0 approaching), tangential_speed (m/s).
+    /// body, partner, partner_is_wall, normal_speed (> 0 approaching), tangential_speed
+    /// (m/s), and where it touched (see `demfem._core.pyi`): point, normal, point_body,
+    /// point_partner (cartridge frames), axis_angle.
     fn onsets<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let o = self.scene.onsets();
         let d = PyDict::new(py);
+        macro_rules! column {
+            ($name:expr, $f:expr) => {
+                d.set_item($name, o.iter().map($f).collect::<Vec<_>>().into_pyarray(py))?;
+            };
+        }
+        column!("time", |x| x.time);
+        column!("body", |x| x.body);
+        column!("partner", |x| x.partner);
+        column!("partner_is_wall", |x| x.partner_is_wall);
+        column!("normal_speed", |x| x.normal_speed);
+        column!("tangential_speed", |x| x.tangential_speed);
+        let rows = |f: &dyn Fn(&demfem::rigid::RigidOnset) -> Vector3<f64>| -> Vec<Vec3> {
+            o.iter().map(|x| from_na(&f(x))).collect()
+        };
+        d.set_item("point", array_n3(py, &rows(&|x| x.point))?)?;
+        d.set_item("normal", array_n3(py, &rows(&|x| x.normal))?)?;
+        let nan = Vector3::repeat(f64::NAN);
+        // a world point in the cartridge frame of body i at the pose it had then
+        let local = |i: u32, pose: &demfem::rigid::BodyPose, p: &Vector3<f64>| {
+            if self.sphere.get(i as usize).copied().unwrap_or(true) {
+                nan
+            } else {
+                self.principal_frame
+                    * pose
+                        .orientation
+                        .inverse_transform_vector(&(p - pose.position))
+            }
+        };
+        let axis_of = |i: u32, pose: &demfem::rigid::BodyPose| {
+            if self.sphere.get(i as usize).copied().unwrap_or(true) {
+                nan
+            } else {
+                pose.orientation * self.principal_frame.inverse_transform_vector(&Vector3::z())
+            }
+        };
         d.set_item(
-            "time",
-            o.iter()
-                .map(|x| x.time)
-                .collect::<Vec<_>>()
-                .into_pyarray(py),
+            "point_body",
+            array_n3(py, &rows(&|x| local(x.body, &x.body_pose, &x.point)))?,
         )?;
         d.set_item(
-            "body",
-            o.iter()
-                .map(|x| x.body)
-                .collect::<Vec<_>>()
-                .into_pyarray(py),
+            "point_partner",
+            array_n3(
+                py,
+                &rows(&|x| match (&x.partner_pose, x.partner_is_wall) {
+                    (Some(pose), false) => local(x.partner, pose, &x.point),
+                    _ => nan,
+                }),
+            )?,
         )?;
-        d.set_item(
-            "partner",
-            o.iter()
-                .map(|x| x.partner)
-                .collect::<Vec<_>>()
-                .into_pyarray(py),
-        )?;
-        d.set_item(
-            "partner_is_wall",
-            o.iter()
-                .map(|x| x.partner_is_wall)
-                .collect::<Vec<_>>()
-                .into_pyarray(py),
-        )?;
-        d.set_item(
-            "normal_speed",
-            o.iter()
-                .map(|x| x.normal_speed)
-                .collect::<Vec<_>>()
-                .into_pyarray(py),
-        )?;
-        d.set_item(
-            "tangential_speed",
-            o.iter()
-                .map(|x| x.tangential_speed)
-                .collect::<Vec<_>>()
-                .into_pyarray(py),
-        )?;
+        column!("axis_angle", |x| {
+            let a = axis_of(x.body, &x.body_pose);
+            // (f64::min would drop the NaN of a sphere's axis)
+            let clamp = |c: f64| if c.is_nan() { c } else { c.abs().min(1.0) };
+            match (&x.partner_pose, x.partner_is_wall) {
+                (Some(pose), false) => clamp(a.dot(&axis_of(x.partner, pose))).acos(),
+                _ => clamp(a.dot(&x.normal)).asin(),
+            }
+        });
         Ok(d)
     }
 

@@ -24,8 +24,8 @@ pub mod shape;
 pub use body::{RigidBodies, RigidBodyInit};
 pub use collision::{BodyPose, ContactPoint, Plane, PolygonWall};
 pub use forces::{ContactMaterial, RigidContactLaw};
-pub use scene::{RigidOnset, RigidScene, RigidSceneConfig, RigidWall};
 pub use revolution::RevolutionShape;
+pub use scene::{RigidOnset, RigidScene, RigidSceneConfig, RigidWall};
 pub use shape::{
     BeadClump, BoundingCapsule, ExactShape, MassProperties, RevolutionProfile, RigidShape,
 };

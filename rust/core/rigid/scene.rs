@@ -39,6 +39,7 @@ use crate::error::{check_positive, DemfemError, Result};
 use crate::geometry::{MeshWall, WallMotion, WallShape};
 
 mod contacts;
+mod revolution_geometry;
 mod revolution_pass;
 
 use contacts::FrictionHistory;
@@ -76,6 +77,9 @@ pub struct RigidSceneConfig {
     pub removal_plane: Option<(Vector3<f64>, Vector3<f64>)>,
     /// Log the first step of every new contact ([`RigidOnset`]).
     pub record_onsets: bool,
+    /// Threads of the contact geometry of bodies of revolution (≥ 1); the result is bitwise
+    /// the same on any number.
+    pub threads: usize,
 }
 
 /// A wall of a rigid scene: a plane or a convex polygon of [`crate::geometry`], translated
@@ -92,7 +96,9 @@ pub struct RigidWall {
 }
 
 /// The first force evaluation of a new contact between a body and another body or a
-/// boundary (a pair counts as one contact however many beads or points touch).
+/// boundary (a pair counts as one contact however many beads or points touch), with where
+/// it touches: the deepest point and the poses of both bodies then, from which the contact's
+/// place on each body (its height along the axis) and the angle between the axes follow.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RigidOnset {
     /// Simulated time, s.
@@ -107,6 +113,15 @@ pub struct RigidOnset {
     pub normal_speed: f64,
     /// Tangential relative speed at that point, m/s.
     pub tangential_speed: f64,
+    /// The deepest contact point, world, m.
+    pub point: Vector3<f64>,
+    /// Unit contact normal there, world: from the wall to the body, or from `body` to
+    /// `partner`.
+    pub normal: Vector3<f64>,
+    /// Pose of `body` at the onset.
+    pub body_pose: BodyPose,
+    /// Pose of `partner` at the onset (`None` for a wall).
+    pub partner_pose: Option<BodyPose>,
 }
 
 /// A wall prepared for the contact pass.
@@ -189,6 +204,7 @@ impl Default for RigidSceneConfig {
             walls: Vec::new(),
             removal_plane: None,
             record_onsets: false,
+            threads: 1,
         }
     }
 }
@@ -239,6 +255,8 @@ pub struct RigidScene {
     wall_contacts: Vec<u32>,
     /// The contact pass of scenes with bodies of revolution (`None` without them).
     revolution: Option<revolution_pass::RevolutionPass>,
+    /// The threads of that pass (`None`: one).
+    pool: Option<rayon::ThreadPool>,
 }
 
 impl RigidScene {
@@ -251,6 +269,24 @@ impl RigidScene {
             });
         }
         check_positive("max_expected_speed", config.max_expected_speed)?;
+        if config.threads == 0 {
+            return Err(DemfemError::invalid("threads", 0.0, "a whole number >= 1"));
+        }
+        let pool = if config.threads > 1 {
+            Some(
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(config.threads)
+                    .build()
+                    .map_err(|e| {
+                        DemfemError::Numerical(format!(
+                            "cannot start {} threads: {e}",
+                            config.threads
+                        ))
+                    })?,
+            )
+        } else {
+            None
+        };
         if let Some(dt) = config.time_step {
             check_positive("time_step", dt)?;
         }
@@ -313,6 +349,7 @@ impl RigidScene {
             coordination: Vec::new(),
             wall_contacts: Vec::new(),
             revolution: None,
+            pool,
         })
     }
 
@@ -370,6 +407,13 @@ impl RigidScene {
             mass: mass.mass,
             principal_inertia: mass.principal_inertia,
         })?;
+        let (shape, mass) = &self.shapes[shape_id];
+        if matches!(shape, RigidShape::Revolution(_))
+            && mass.principal_inertia.x == mass.principal_inertia.y
+        {
+            // bodies of revolution turn as symmetric tops, in closed form
+            self.bodies.set_symmetric_top(index, true)?;
+        }
         self.body_shape.push(shape_id);
         self.alive.push(true);
         self.coordination.push(0);
@@ -386,7 +430,11 @@ impl RigidScene {
             .model
             .e_star_body_body
             .max(self.model.e_star_body_plane);
-        for &shape_id in &self.body_shape {
+        // each shape in use once: the limit is the same for every body of a shape
+        let mut in_use = self.body_shape.clone();
+        in_use.sort_unstable();
+        in_use.dedup();
+        for &shape_id in &in_use {
             let (shape, mass) = &self.shapes[shape_id];
             let m_eff = smallest_effective_mass(shape.surface_sample(), mass);
             let radius = shape.min_contact_radius();

@@ -39,7 +39,9 @@
 
 use nalgebra::Vector3;
 
-use super::features::{piece_pair, segment_parameters, Feature, FeaturePair, Placed};
+use super::features::{
+    piece_pair_cached, segment_parameters, CandidateCache, Feature, FeaturePair, Placed,
+};
 use crate::rigid::collision::ContactPoint;
 
 type V3 = Vector3<f64>;
@@ -113,7 +115,14 @@ pub fn line_pair(a: &Rod, b: &Rod) -> (f64, f64, f64) {
 
 /// The two end samples of a line pair of weight `gh` over [α, β] = [`lo`, `hi`] with the
 /// deepest point at `sigma` along `a` (`None`: halfway).
-pub fn line_samples(a: &Rod, b: &Rod, gh: f64, lo: f64, hi: f64, sigma: Option<f64>) -> [LineSample; 2] {
+pub fn line_samples(
+    a: &Rod,
+    b: &Rod,
+    gh: f64,
+    lo: f64,
+    hi: f64,
+    sigma: Option<f64>,
+) -> [LineSample; 2] {
     let ell = hi - lo;
     let s = sigma.unwrap_or(0.5 * (lo + hi)).clamp(lo, hi);
     let shares = [(s - lo) / ell, (hi - s) / ell];
@@ -156,16 +165,17 @@ pub fn piece_rod(x: &Placed, i: usize) -> Rod {
     }
 }
 
-/// Hertz contact radius of a feature touched at `point` with the outward normal `outward`,
-/// m: a side's or face's radius, at an edge interpolated across its normal cone
-/// ([`super::EdgeCircle::contact_radius`]).
-pub fn feature_radius(x: &Placed, feature: Feature, point: &V3, outward: &V3) -> f64 {
+/// Hertz contact radius of a feature touched at `point`, m: the local radius r(z) of a side
+/// at the point's height, an edge circle's radius, a face's outer radius — continuous as a
+/// contact slides from one feature onto the next (a jump would do work: the potential
+/// 2/5 k_H δ^{5/2} would change at a fixed overlap), constant along a cylinder.
+pub fn feature_radius(x: &Placed, feature: Feature, point: &V3) -> f64 {
     match feature {
-        Feature::Side(i) => x.shape.frustums[i].contact_radius,
-        Feature::Edge(k) => {
-            let (_, radial, _) = x.meridian(point);
-            x.shape.circles[k].contact_radius(outward.dot(&x.axis), outward.dot(&radial))
+        Feature::Side(i) => {
+            let f = &x.shape.frustums[i];
+            f.radius_at((point - x.origin).dot(&x.axis).clamp(f.z[0], f.z[1]))
         }
+        Feature::Edge(k) => x.shape.circles[k].r,
         Feature::Face(f) => x.shape.faces[f].contact_radius,
     }
 }
@@ -179,9 +189,28 @@ pub fn belongs_to(x: &Placed, feature: Feature, i: usize) -> bool {
     }
 }
 
+/// The pieces of `x` (with their rods) whose capsules reach the bounding capsule of `y`.
+fn near_pieces(x: &Placed, y: &Placed, out: &mut Vec<(usize, Rod)>) {
+    out.clear();
+    let capsule = y.shape.bounding_capsule;
+    let (c0, c1) = (y.at(capsule.z_min), y.at(capsule.z_max));
+    for (i, f) in x.shape.frustums.iter().enumerate() {
+        let rod = piece_rod(x, i);
+        let (s, t, _) =
+            segment_parameters(&rod.start, &(rod.direction * rod.length), &c0, &(c1 - c0));
+        let gap = rod.start + rod.direction * (s * rod.length) - c0 - (c1 - c0) * t;
+        if gap.norm() < f.reach + capsule.radius {
+            out.push((i, rod));
+        }
+    }
+}
+
 /// Reusable buffers of [`pair_contacts`].
 #[derive(Debug, Default, Clone)]
 pub struct PairScratch {
+    cache: CandidateCache,
+    near_a: Vec<(usize, Rod)>,
+    near_b: Vec<(usize, Rod)>,
     found: Vec<(FeaturePair, usize, usize, bool)>,
     lines: Vec<(usize, usize, f64, f64, f64, Option<f64>)>,
 }
@@ -197,13 +226,14 @@ pub fn pair_contacts(
 ) {
     scratch.found.clear();
     scratch.lines.clear();
-    let (na, nb) = (a.shape.frustums.len(), b.shape.frustums.len());
-    for i in 0..na {
+    scratch.cache.clear();
+    // the pieces of each body that can reach the other's bounding capsule
+    near_pieces(a, b, &mut scratch.near_a);
+    near_pieces(b, a, &mut scratch.near_b);
+    for &(i, rod_a) in &scratch.near_a {
         let fa = a.shape.frustums[i];
-        let rod_a = piece_rod(a, i);
-        for j in 0..nb {
+        for &(j, rod_b) in &scratch.near_b {
             let fb = b.shape.frustums[j];
-            let rod_b = piece_rod(b, j);
             let (s, t, _) = segment_parameters(
                 &rod_a.start,
                 &(rod_a.direction * rod_a.length),
@@ -215,7 +245,7 @@ pub fn pair_contacts(
             if gap.norm() >= fa.reach + fb.reach {
                 continue;
             }
-            let found = piece_pair(a, i, b, j);
+            let found = piece_pair_cached(a, i, b, j, 0.0, &mut scratch.cache);
             let line = if fa.is_cylinder() && fb.is_cylinder() {
                 line_pair(&rod_a, &rod_b)
             } else {
@@ -242,9 +272,9 @@ pub fn pair_contacts(
             continue;
         }
         let owned = own
-            || scratch.found[k + 1..].iter().any(|e| {
-                e.3 && e.0.feature_a == f.feature_a && e.0.feature_b == f.feature_b
-            });
+            || scratch.found[k + 1..]
+                .iter()
+                .any(|e| e.3 && e.0.feature_a == f.feature_a && e.0.feature_b == f.feature_b);
         let weight = if owned {
             1.0
         } else {
@@ -278,8 +308,8 @@ pub fn pair_contacts(
                     point: 0.5 * (f.point_a + f.point_b),
                     normal: f.normal,
                     overlap: -f.distance,
-                    radius_first: feature_radius(a, f.feature_a, &f.point_a, &f.normal),
-                    radius_second: feature_radius(b, f.feature_b, &f.point_b, &(-f.normal)),
+                    radius_first: feature_radius(a, f.feature_a, &f.point_a),
+                    radius_second: feature_radius(b, f.feature_b, &f.point_b),
                     feature_first: f.feature_a.key(),
                     feature_second: f.feature_b.key(),
                 });
@@ -310,7 +340,14 @@ pub fn pair_contacts(
 /// of the circle at quarter turns anchored at its deepest point along the face normal, as on
 /// a plane (so that two cartridges end to end press rim on rim evenly), each kept where it
 /// overlaps the face, projects onto it and lies in X's piece; appended oriented X → Y.
-fn face_points(x: &Placed, face: usize, piece: usize, y: &Placed, edge: usize, out: &mut Vec<ContactPoint>) {
+fn face_points(
+    x: &Placed,
+    face: usize,
+    piece: usize,
+    y: &Placed,
+    edge: usize,
+    out: &mut Vec<ContactPoint>,
+) {
     let f = x.shape.faces[face];
     let circle = y.shape.circles[edge];
     let m = x.axis * f.facing;
@@ -325,7 +362,7 @@ fn face_points(x: &Placed, face: usize, piece: usize, y: &Placed, edge: usize, o
     };
     let centre = y.at(circle.z);
     let tolerance = 1e-6 * f.r[1];
-    let radius_y = circle.contact_radius(-m.dot(&y.axis), s);
+    let radius_y = circle.r;
     let quarter = [(1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0)];
     for (j, (c, sn)) in quarter.into_iter().enumerate() {
         let p = centre + (u * c + v * sn) * circle.r;
@@ -380,8 +417,7 @@ pub fn plane_contacts(
         if depth + circle.r * s <= 0.0 {
             continue;
         }
-        // the body's outward normal at the circle is −normal, in its meridian plane
-        let radius = circle.contact_radius(-normal.dot(&body.axis), s);
+        let radius = circle.r;
         let quarter = [(1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0)];
         for (j, (c, sn)) in quarter.into_iter().enumerate() {
             let overlap = depth + circle.r * s * c;
@@ -427,8 +463,7 @@ pub fn bead_contact(centre: &V3, radius: f64, body: &Placed) -> Option<ContactPo
         .position(|w| {
             let (ez, er) = (w[1].0 - w[0].0, w[1].1 - w[0].1);
             let (dz, dr) = (q.0 - w[0].0, q.1 - w[0].1);
-            (ez * dr - er * dz).abs() <= 1e-12 * (ez.abs() + er.abs())
-                && dz * ez + dr * er >= 0.0
+            (ez * dr - er * dz).abs() <= 1e-12 * (ez.abs() + er.abs()) && dz * ez + dr * er >= 0.0
         })
         .unwrap_or(0);
     Some(ContactPoint {

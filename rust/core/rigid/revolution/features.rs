@@ -137,8 +137,16 @@ pub fn segment_parameters(p0: &V3, d1: &V3, q0: &V3, d2: &V3) -> (f64, f64, bool
     let denom = a * e - b * b;
     let tiny = 1e-30;
     if a <= tiny || e <= tiny {
-        let s = if a <= tiny { 0.0 } else { (-c / a).clamp(0.0, 1.0) };
-        let t = if e <= tiny { 0.0 } else { (f / e).clamp(0.0, 1.0) };
+        let s = if a <= tiny {
+            0.0
+        } else {
+            (-c / a).clamp(0.0, 1.0)
+        };
+        let t = if e <= tiny {
+            0.0
+        } else {
+            (f / e).clamp(0.0, 1.0)
+        };
         return (s, t, false);
     }
     let raw_s = if denom > 1e-14 * a * e {
@@ -217,9 +225,8 @@ pub fn sweep_closest(a: &Sweep, b: &Sweep) -> Option<(f64, f64)> {
         return interior.then_some((sigma, tau));
     }
     let (ka, kb) = (a.k, b.k);
-    let f_of = |sg: f64, ta: f64| -> f64 {
-        (w + ua * sg - ub * ta).norm() - a.radius(sg) - b.radius(ta)
-    };
+    let f_of =
+        |sg: f64, ta: f64| -> f64 { (w + ua * sg - ub * ta).norm() - a.radius(sg) - b.radius(ta) };
     let scale = (sa1 - sa0).max(sb1 - sb0);
     for _ in 0..40 {
         let d = w + ua * sigma - ub * tau;
@@ -293,62 +300,126 @@ pub fn side_side(a: &Placed, i: usize, b: &Placed, j: usize) -> Option<FeaturePa
     })
 }
 
-/// Minimum over θ ∈ [0, 2π) of a smooth periodic function given with its first two
-/// derivatives: the best of `samples` equally spaced values, refined by Newton steps
-/// safeguarded by bisection on the derivative within one spacing either side. Returns
-/// (θ, value).
-pub fn periodic_minimum(samples: usize, f: impl Fn(f64) -> (f64, f64, f64)) -> (f64, f64) {
-    let h = 2.0 * std::f64::consts::PI / samples as f64;
-    let mut best = (0.0, f64::INFINITY);
-    for k in 0..samples {
-        let theta = h * k as f64;
-        let v = f(theta).0;
-        if v < best.1 {
-            best = (theta, v);
-        }
-    }
-    let (mut lo, mut hi) = (best.0 - h, best.0 + h);
-    let mut theta = best.0;
-    for _ in 0..60 {
-        let (_, d1, d2) = f(theta);
-        // the bracket keeps the minimum: f' < 0 left of it, > 0 right of it
-        if d1 > 0.0 {
-            hi = theta;
-        } else if d1 < 0.0 {
-            lo = theta;
-        } else {
-            break;
-        }
-        let newton = if d2 > 0.0 { theta - d1 / d2 } else { f64::NAN };
-        let next = if newton > lo && newton < hi {
-            newton
-        } else {
-            0.5 * (lo + hi)
-        };
-        let moved = (next - theta).abs();
-        theta = next;
-        if moved <= 1e-15 || hi - lo <= 1e-15 {
-            break;
-        }
-    }
-    (theta, f(theta).0)
+/// A direction in a circle's plane as (cos θ, sin θ): the circle searches move along the
+/// circle by rotating unit vectors, with no trigonometric function.
+pub type Turn = (f64, f64);
+
+#[inline]
+fn cross2(a: Turn, b: Turn) -> f64 {
+    a.0 * b.1 - a.1 * b.0
 }
 
-/// Samples of the circle searches.
-const CIRCLE_SAMPLES: usize = 8;
-
-/// A point of edge circle `k` of `x` at angle θ (from body x towards body y), its centre
-/// and the derivative of the point in θ.
+/// `u` turned by atan(t).
 #[inline]
-pub(crate) fn circle_point(x: &Placed, k: usize, theta: f64) -> (V3, V3, V3) {
+fn rotate(u: Turn, t: f64) -> Turn {
+    let n = (1.0 + t * t).sqrt();
+    ((u.0 - u.1 * t) / n, (u.1 + u.0 * t) / n)
+}
+
+/// The eight sample directions of a circle search, 45° apart.
+const SAMPLES: [Turn; 8] = {
+    let r = std::f64::consts::FRAC_1_SQRT_2;
+    [
+        (1.0, 0.0),
+        (r, r),
+        (0.0, 1.0),
+        (-r, r),
+        (-1.0, 0.0),
+        (-r, -r),
+        (0.0, -1.0),
+        (r, -r),
+    ]
+};
+
+/// Minimum over the circle of a smooth function of the direction u = (cos θ, sin θ), given
+/// with its first two derivatives in θ: from `start` when given (a guess close to the
+/// minimum), else from the best of eight samples, by Newton steps safeguarded by bisection
+/// on the derivative within ±45°; a search from a guess that ends on that bracket's edge is
+/// redone from the samples. Returns (u, value).
+pub fn circle_minimum(start: Option<Turn>, f: impl Fn(f64, f64) -> (f64, f64, f64)) -> (Turn, f64) {
+    let sampled = || {
+        let mut best = (SAMPLES[0], f64::INFINITY);
+        for u in SAMPLES {
+            let v = f(u.0, u.1).0;
+            if v < best.1 {
+                best = (u, v);
+            }
+        }
+        best.0
+    };
+    let refine = |begin: Turn| -> (Turn, bool) {
+        let (mut lo, mut hi) = (rotate(begin, -1.0), rotate(begin, 1.0));
+        let mut u = begin;
+        for _ in 0..60 {
+            let (_, d1, d2) = f(u.0, u.1);
+            // the bracket keeps the minimum: f' < 0 before it, > 0 after it
+            if d1 > 0.0 {
+                hi = u;
+            } else if d1 < 0.0 {
+                lo = u;
+            } else {
+                break;
+            }
+            let inside = |w: Turn| cross2(lo, w) > 0.0 && cross2(w, hi) > 0.0;
+            let newton = if d2 > 0.0 {
+                Some(rotate(u, -d1 / d2))
+            } else {
+                None
+            };
+            let next = match newton {
+                Some(w) if inside(w) => w,
+                _ => {
+                    let (c, s) = (lo.0 + hi.0, lo.1 + hi.1);
+                    let n = c.hypot(s);
+                    (c / n, s / n)
+                }
+            };
+            let moved = cross2(u, next).abs();
+            u = next;
+            if moved <= 1e-15 || cross2(lo, hi) <= 1e-15 {
+                break;
+            }
+        }
+        let edge = |w: Turn| cross2(w, u).abs() <= 1e-12 && w.0 * u.0 + w.1 * u.1 > 0.0;
+        let on_edge = edge(rotate(begin, -1.0)) || edge(rotate(begin, 1.0));
+        (u, on_edge)
+    };
+    let u = match start {
+        Some(guess) => match refine(guess) {
+            (u, false) => u,
+            _ => refine(sampled()).0,
+        },
+        None => refine(sampled()).0,
+    };
+    (u, f(u.0, u.1).0)
+}
+
+/// A point of edge circle `k` of `x` in the direction u = (cos θ, sin θ) (from body x
+/// towards body y), its centre and the derivative of the point in θ.
+#[inline]
+pub(crate) fn circle_point(x: &Placed, k: usize, u: Turn) -> (V3, V3, V3) {
     let c = &x.shape.circles[k];
     let centre = x.at(c.z);
-    let (s, co) = theta.sin_cos();
     (
-        centre + (x.x * co + x.y * s) * c.r,
+        centre + (x.x * u.0 + x.y * u.1) * c.r,
         centre,
-        (x.y * co - x.x * s) * c.r,
+        (x.y * u.0 - x.x * u.1) * c.r,
     )
+}
+
+/// The direction in the plane of circle `k` of `x` towards the world point `target`, when
+/// the circle's axis is within 18° of `axis` (the other piece's) and the target lies off
+/// the middle of the disc: a guess for the circle searches of nearly parallel bodies (where
+/// the closest point faces the other axis), else `None` (sample).
+#[inline]
+fn facing(x: &Placed, k: usize, axis: &V3, target: &V3) -> Option<Turn> {
+    if x.axis.dot(axis).abs() < 0.95 {
+        return None;
+    }
+    let w = target - x.at(x.shape.circles[k].z);
+    let (c, s) = (w.dot(&x.x), w.dot(&x.y));
+    let n = c.hypot(s);
+    (n > 0.5 * x.shape.circles[k].r).then(|| (c / n, s / n))
 }
 
 /// Whether the world direction `n` (pointing out of body `x` at its point `p`) lies in the
@@ -373,8 +444,7 @@ pub fn circle_side(x: &Placed, k: usize, y: &Placed, j: usize) -> Option<Feature
     let (nc, ns) = (2.0 * rho * q0.dot(&x.x), 2.0 * rho * q0.dot(&x.y));
     let (k_slope, cos) = (piece.slope, piece.cos);
     let offset = piece.r[0] - k_slope * piece.z[0];
-    let eval = |theta: f64| -> (f64, f64, f64) {
-        let (s, c) = theta.sin_cos();
+    let eval = |c: f64, s: f64| -> (f64, f64, f64) {
         let z = z0 + zc * c + zs * s;
         let dz = -zc * s + zs * c;
         let ddz = -(z - z0);
@@ -393,8 +463,9 @@ pub fn circle_side(x: &Placed, k: usize, y: &Placed, j: usize) -> Option<Feature
             cos * (ddr - k_slope * ddz),
         )
     };
-    let (theta, distance) = periodic_minimum(CIRCLE_SAMPLES, eval);
-    let (p, _, _) = circle_point(x, k, theta);
+    let towards = y.origin + b * (centre - y.origin).dot(&b);
+    let (u, distance) = circle_minimum(facing(x, k, &b, &towards), eval);
+    let (p, _, _) = circle_point(x, k, u);
     let (zp, radial, rho_y) = y.meridian(&p);
     if rho_y <= 1e-15 {
         return None;
@@ -446,8 +517,7 @@ pub fn circle_circle(a: &Placed, k: usize, b: &Placed, l: usize) -> Option<Featu
         2.0 * r1 * q0.dot(&a.y),
     );
     let (b0, bc, bs) = (eb.dot(&q0), r1 * eb.dot(&a.x), r1 * eb.dot(&a.y));
-    let eval = |theta: f64| -> (f64, f64, f64) {
-        let (s, c) = theta.sin_cos();
+    let eval = |c: f64, s: f64| -> (f64, f64, f64) {
         let av = a0 + ac * c + as_ * s;
         let da = -ac * s + as_ * c;
         let dda = -(av - a0);
@@ -465,8 +535,8 @@ pub fn circle_circle(a: &Placed, k: usize, b: &Placed, l: usize) -> Option<Featu
             dda - 2.0 * r2 * ddrho,
         )
     };
-    let (theta, _) = periodic_minimum(CIRCLE_SAMPLES, eval);
-    let (p, _, tangent_a) = circle_point(a, k, theta);
+    let (u, _) = circle_minimum(facing(a, k, &eb, &centre_b), eval);
+    let (p, _, tangent_a) = circle_point(a, k, u);
     let (_, radial_b, rho) = b.meridian(&p);
     if rho <= 1e-15 {
         return None;
@@ -503,7 +573,11 @@ pub fn face_circle(x: &Placed, f: usize, y: &Placed, l: usize) -> Option<Feature
     let face_centre = x.at(face.z);
     let in_plane = m - y.axis * m.dot(&y.axis);
     let length = in_plane.norm();
-    let direction = if length > 1e-12 { in_plane / length } else { y.x };
+    let direction = if length > 1e-12 {
+        in_plane / length
+    } else {
+        y.x
+    };
     let p = y.at(circle.z) - direction * circle.r;
     let distance = m.dot(&(p - face_centre));
     let (_, _, rho) = x.meridian(&p);
@@ -558,6 +632,46 @@ pub fn piece_pair_within(
     j: usize,
     margin: f64,
 ) -> Option<FeaturePair> {
+    piece_pair_cached(a, i, b, j, margin, &mut CandidateCache::default())
+}
+
+/// Candidate feature pairs already solved for one pair of bodies (an edge circle belongs to
+/// two pieces, a flat step's face too: their candidates are solved once per body pair).
+#[derive(Debug, Default, Clone)]
+pub struct CandidateCache {
+    solved: Vec<(Feature, Feature, Option<FeaturePair>)>,
+}
+
+impl CandidateCache {
+    /// Forget the solutions (for a new pair of bodies or a new configuration).
+    pub fn clear(&mut self) {
+        self.solved.clear();
+    }
+
+    fn solve(
+        &mut self,
+        fa: Feature,
+        fb: Feature,
+        compute: impl FnOnce() -> Option<FeaturePair>,
+    ) -> Option<FeaturePair> {
+        if let Some(e) = self.solved.iter().find(|e| e.0 == fa && e.1 == fb) {
+            return e.2;
+        }
+        let found = compute();
+        self.solved.push((fa, fb, found));
+        found
+    }
+}
+
+/// As [`piece_pair_within`], reusing the solutions of `cache` (same bodies, same poses).
+pub fn piece_pair_cached(
+    a: &Placed,
+    i: usize,
+    b: &Placed,
+    j: usize,
+    margin: f64,
+    cache: &mut CandidateCache,
+) -> Option<FeaturePair> {
     if let Some(found) = side_side(a, i, b, j) {
         if found.distance >= 0.0
             || (inside_piece(b, j, &found.point_a) && inside_piece(a, i, &found.point_b))
@@ -567,47 +681,72 @@ pub fn piece_pair_within(
     }
     let (fa, fb) = (a.shape.frustums[i], b.shape.frustums[j]);
     let mut best: Option<FeaturePair> = None;
-    let mut consider = |c: Option<FeaturePair>| {
+    // in contact mode (margin 0) the first valid overlap ends the search: between shallowly
+    // overlapping convex pieces one feature pair is valid (two only where a contact passes
+    // from one to the next, at the same point)
+    let settled =
+        |best: &Option<FeaturePair>| margin <= 0.0 && best.is_some_and(|b| b.distance < 0.0);
+    let consider = |c: Option<FeaturePair>, best: &mut Option<FeaturePair>| {
         if let Some(c) = c {
             // an overlap is real only where each closest point lies in the other piece (a
             // face's half-space or an edge's cone alone would accept points far beyond it)
             let real = c.distance >= 0.0
                 || (inside_piece(b, j, &c.point_a) && inside_piece(a, i, &c.point_b));
             if real && best.is_none_or(|b| c.distance > b.distance) {
-                best = Some(c);
+                *best = Some(c);
             }
         }
     };
     let convex_a = |k: &usize| a.shape.circles[*k].convex;
     let convex_b = |l: &usize| b.shape.circles[*l].convex;
-    for k in fa.circles.iter().filter(|k| convex_a(k)) {
-        let c = a.shape.circles[*k];
-        if distance_to_piece_axis(b, j, &a.at(c.z)) < c.r + fb.reach + margin {
-            consider(circle_side(a, *k, b, j));
+    use Feature::{Edge, Face, Side};
+    for &k in fa.circles.iter().filter(|k| convex_a(k)) {
+        let c = a.shape.circles[k];
+        if !settled(&best) && distance_to_piece_axis(b, j, &a.at(c.z)) < c.r + fb.reach + margin {
+            consider(
+                cache.solve(Edge(k), Side(j), || circle_side(a, k, b, j)),
+                &mut best,
+            );
         }
     }
-    for l in fb.circles.iter().filter(|l| convex_b(l)) {
-        let c = b.shape.circles[*l];
-        if distance_to_piece_axis(a, i, &b.at(c.z)) < c.r + fa.reach + margin {
-            consider(circle_side(b, *l, a, i).map(FeaturePair::reversed));
+    for &l in fb.circles.iter().filter(|l| convex_b(l)) {
+        let c = b.shape.circles[l];
+        if !settled(&best) && distance_to_piece_axis(a, i, &b.at(c.z)) < c.r + fa.reach + margin {
+            let found = cache.solve(Side(i), Edge(l), || {
+                circle_side(b, l, a, i).map(FeaturePair::reversed)
+            });
+            consider(found, &mut best);
         }
     }
-    for k in fa.circles.iter().filter(|k| convex_a(k)) {
-        for l in fb.circles.iter().filter(|l| convex_b(l)) {
-            let (ck, cl) = (a.shape.circles[*k], b.shape.circles[*l]);
-            if (a.at(ck.z) - b.at(cl.z)).norm() < ck.r + cl.r + margin {
-                consider(circle_circle(a, *k, b, *l));
+    for &k in fa.circles.iter().filter(|k| convex_a(k)) {
+        for &l in fb.circles.iter().filter(|l| convex_b(l)) {
+            let (ck, cl) = (a.shape.circles[k], b.shape.circles[l]);
+            if !settled(&best) && (a.at(ck.z) - b.at(cl.z)).norm() < ck.r + cl.r + margin {
+                consider(
+                    cache.solve(Edge(k), Edge(l), || circle_circle(a, k, b, l)),
+                    &mut best,
+                );
             }
         }
     }
-    for f in fa.faces.iter().flatten() {
-        for l in fb.circles.iter().filter(|l| convex_b(l)) {
-            consider(face_circle(a, *f, b, *l));
+    for &f in fa.faces.iter().flatten() {
+        for &l in fb.circles.iter().filter(|l| convex_b(l)) {
+            if !settled(&best) {
+                consider(
+                    cache.solve(Face(f), Edge(l), || face_circle(a, f, b, l)),
+                    &mut best,
+                );
+            }
         }
     }
-    for f in fb.faces.iter().flatten() {
-        for k in fa.circles.iter().filter(|k| convex_a(k)) {
-            consider(face_circle(b, *f, a, *k).map(FeaturePair::reversed));
+    for &f in fb.faces.iter().flatten() {
+        for &k in fa.circles.iter().filter(|k| convex_a(k)) {
+            if !settled(&best) {
+                let found = cache.solve(Edge(k), Face(f), || {
+                    face_circle(b, f, a, k).map(FeaturePair::reversed)
+                });
+                consider(found, &mut best);
+            }
         }
     }
     best

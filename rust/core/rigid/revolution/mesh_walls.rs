@@ -105,6 +105,13 @@ pub fn mesh_contacts(
                 }
             }
         }
-        corner_contact(&vertex(v), &neighbours, VERTEX_KEY + v as u64, body, out, weights);
+        corner_contact(
+            &vertex(v),
+            &neighbours,
+            VERTEX_KEY + v as u64,
+            body,
+            out,
+            weights,
+        );
     }
 }

@@ -41,7 +41,8 @@ pub struct Frustum {
     pub slope: f64,
     /// 1/√(1 + slope²): the cosine of the half-angle of the cone.
     pub cos: f64,
-    /// Hertz contact radius of the side, m: the mean radius, as the parry shape's pieces.
+    /// Mean radius of the side, m (the Hertz radius of the parry shape's piece; this shape
+    /// uses the local radius, [`Frustum::radius_at`]).
     pub contact_radius: f64,
     /// Largest radius, m (the bounding capsule of the piece).
     pub reach: f64,
@@ -86,27 +87,9 @@ pub struct EdgeCircle {
     /// touching partner has the angle φ = atan2(n_ρ, n_z) in `[cone[0], cone[1]]`, rad
     /// (0: along +z, π/2: radial, π: along −z).
     pub cone: [f64; 2],
-    /// Hertz contact radius of the surface on either side of the edge, m: of the element
-    /// whose normal bounds the cone at `cone[0]` (above the edge) and at `cone[1]` (below).
-    pub side_radius: [f64; 2],
 }
 
 impl EdgeCircle {
-    /// Hertz contact radius of a contact at the edge whose outward normal has the meridian
-    /// components (n_z, n_ρ), m: interpolated linearly in the normal's angle across the cone
-    /// between the radii of the two sides, so that a contact sliding from a side over the
-    /// edge onto the next keeps a continuous stiffness (the pieces' radii are those of the
-    /// parry shape).
-    #[inline]
-    pub fn contact_radius(&self, n_z: f64, n_rho: f64) -> f64 {
-        let width = self.cone[1] - self.cone[0];
-        if width <= 0.0 {
-            return self.side_radius[0];
-        }
-        let t = ((n_rho.atan2(n_z) - self.cone[0]) / width).clamp(0.0, 1.0);
-        self.side_radius[0] + t * (self.side_radius[1] - self.side_radius[0])
-    }
-
     /// Whether the meridian direction (n_z, n_ρ) lies in the normal cone, with a tolerance
     /// of `tolerance` rad.
     #[inline]
@@ -135,8 +118,8 @@ pub struct FlatFace {
     pub facing: f64,
     /// The edge circle at its outer radius.
     pub outer_circle: usize,
-    /// Hertz contact radius of the face, m (the adjacent piece's, as the parry shape; the
-    /// outer radius for a face between two flat steps).
+    /// Hertz contact radius of the face, m: its outer radius (that of the edge around it,
+    /// so that a contact sliding from the face over the edge keeps its stiffness).
     pub contact_radius: f64,
 }
 
@@ -152,8 +135,6 @@ pub struct RevolutionShape {
     /// The outer profile in the meridian half-plane, (z, ρ) points from (z_bottom, 0) up
     /// the outside to (z_top, 0): the polyline that bounds the solid, m.
     pub outline: Vec<(f64, f64)>,
-    /// Hertz contact radius at each segment of `outline`, m.
-    pub outline_contact_radius: Vec<f64>,
     /// Radius of the bounding sphere about the origin, m.
     pub bounding_radius: f64,
     /// Capsule along body z containing the shape.
@@ -265,8 +246,8 @@ impl RevolutionShape {
             contact_radius: 0.0,
         });
         between.push(Element::Face(faces.len() - 1));
-        // faces attached to the pieces next to them; each face's contact radius is its
-        // neighbouring piece's
+        // faces attached to the pieces next to them; each face's contact radius is its outer
+        // radius
         for (k, e) in between.iter().enumerate() {
             let Element::Face(f) = *e else { continue };
             let neighbours = [
@@ -277,12 +258,9 @@ impl RevolutionShape {
                 if let Some(Element::Side(i)) = nb {
                     // the face is above piece i (side 0) or below it (side 1)
                     frustums[i].faces[1 - side] = Some(f);
-                    faces[f].contact_radius = faces[f].contact_radius.max(frustums[i].contact_radius);
                 }
             }
-            if faces[f].contact_radius == 0.0 {
-                faces[f].contact_radius = faces[f].r[1];
-            }
+            faces[f].contact_radius = faces[f].r[1];
         }
         let angle = |e: Element| match e {
             Element::Side(i) => side_angle(frustums[i].slope),
@@ -294,10 +272,6 @@ impl RevolutionShape {
                 }
             }
         };
-        let radius_of = |e: Element| match e {
-            Element::Side(i) => frustums[i].contact_radius,
-            Element::Face(f) => faces[f].contact_radius,
-        };
         let mut circles = Vec::with_capacity(n);
         for (k, &(z, r)) in stations.iter().enumerate() {
             let (below, above) = (angle(between[k]), angle(between[k + 1]));
@@ -306,19 +280,10 @@ impl RevolutionShape {
                 r,
                 convex: above < below - EDGE_ANGLE_TOLERANCE,
                 cone: [above, below],
-                side_radius: [radius_of(between[k + 1]), radius_of(between[k])],
             });
         }
         let mut outline = vec![(stations[0].0, 0.0)];
-        let mut outline_contact_radius = vec![faces[0].contact_radius];
-        for k in 0..n {
-            outline.push(stations[k]);
-            let radius = match between[k + 1] {
-                Element::Side(i) => frustums[i].contact_radius,
-                Element::Face(f) => faces[f].contact_radius,
-            };
-            outline_contact_radius.push(radius);
-        }
+        outline.extend(stations.iter().copied());
         outline.push((stations[n - 1].0, 0.0));
         let mut bounding_radius: f64 = 0.0;
         let mut rim_points = Vec::with_capacity(16 * n);
@@ -329,11 +294,7 @@ impl RevolutionShape {
                 rim_points.push(Vector3::new(r * t.cos(), r * t.sin(), z));
             }
         }
-        let min_contact_radius = frustums
-            .iter()
-            .map(|f| f.contact_radius)
-            .chain(faces.iter().map(|f| f.contact_radius))
-            .fold(f64::INFINITY, f64::min);
+        let min_contact_radius = stations.iter().map(|s| s.1).fold(f64::INFINITY, f64::min);
         let bounding_capsule = BoundingCapsule {
             z_min: stations[0].0,
             z_max: stations[n - 1].0,
@@ -344,7 +305,6 @@ impl RevolutionShape {
             circles,
             faces,
             outline,
-            outline_contact_radius,
             bounding_radius,
             bounding_capsule,
             rim_points,
@@ -354,10 +314,11 @@ impl RevolutionShape {
 
     /// Signed distance of the point (z, ρ) of the meridian half-plane (body frame) from the
     /// solid (negative inside), the closest point of the outline (z, ρ), its outward unit
-    /// normal (n_z, n_ρ) and the Hertz contact radius there, m.
+    /// normal (n_z, n_ρ) and the Hertz contact radius there, m (the local radius r(z) on a
+    /// side or an edge, the outer radius on a face: continuous over the surface).
     pub fn meridian_distance(&self, z: f64, rho: f64) -> (f64, (f64, f64), (f64, f64), f64) {
-        // (squared distance, closest point, outward normal of the segment, segment, t)
-        let mut best = (f64::INFINITY, (0.0, 0.0), (1.0, 0.0), 0, 0.0);
+        // (squared distance, closest point, outward normal of the segment, segment)
+        let mut best = (f64::INFINITY, (0.0, 0.0), (1.0, 0.0), 0);
         for k in 0..self.outline.len() - 1 {
             let (a, b) = (self.outline[k], self.outline[k + 1]);
             let (ez, er) = (b.0 - a.0, b.1 - a.1);
@@ -373,10 +334,10 @@ impl RevolutionShape {
                 // outward normal of the segment: the outline runs clockwise in (z, ρ)
                 // seen with ρ up, so the outside is to the left of its direction
                 let len = len2.sqrt();
-                best = (d2, q, (-er / len, ez / len), k, t);
+                best = (d2, q, (-er / len, ez / len), k);
             }
         }
-        let (d2, q, side_normal, k, t) = best;
+        let (d2, q, side_normal, k) = best;
         let distance = d2.sqrt();
         let inside = self.contains(z, rho);
         let normal = if distance > 1e-300 {
@@ -389,19 +350,10 @@ impl RevolutionShape {
         } else {
             side_normal
         };
-        // a corner of the outline off the axis is a station: outline point m is station m − 1
-        let corner = if t <= 0.0 { k } else { k + 1 };
-        let radius = if t > 0.0 && t < 1.0 || corner == 0 || corner > self.circles.len() {
-            self.outline_contact_radius[k]
-        } else {
-            self.circles[corner - 1].contact_radius(normal.0, normal.1)
-        };
-        (
-            if inside { -distance } else { distance },
-            q,
-            normal,
-            radius,
-        )
+        // the Hertz radius: the local radius on a side or edge, the outer radius on a face
+        let (a, b) = (self.outline[k], self.outline[k + 1]);
+        let radius = if a.0 == b.0 { a.1.max(b.1) } else { q.1 };
+        (if inside { -distance } else { distance }, q, normal, radius)
     }
 
     /// Whether the point (z, ρ) of the meridian half-plane lies inside the solid.
@@ -441,12 +393,9 @@ mod tests {
         assert!((d + 0.5e-3).abs() < 1e-15 && n == (0.0, 1.0), "{d} {n:?}");
         let (d, q, _, r) = s.meridian_distance(-1e-3, 6.8e-3);
         assert!((d - 2f64.sqrt() * 1e-3).abs() < 1e-15 && q == (0.0, 5.8e-3) && r == 5.8e-3);
-        // past the body–shoulder edge: the radius runs from the body's to the shoulder's
-        let edge = s.circles[1];
-        assert!((edge.side_radius[0] - 4.4e-3).abs() < 1e-15 && edge.side_radius[1] == 5.8e-3);
-        assert_eq!(edge.contact_radius(0.0, 1.0), 5.8e-3);
-        let (c, sn) = (edge.cone[0].cos(), edge.cone[0].sin());
-        assert!((edge.contact_radius(c, sn) - 4.4e-3).abs() < 1e-15);
+        // on the shoulder the radius is the local one
+        let (_, q, _, r) = s.meridian_distance(0.0565, 5e-3);
+        assert!(r == q.1 && r > 3e-3 && r < 5.8e-3);
         let (d, _, n, _) = s.meridian_distance(-1e-3, 1e-3);
         assert!((d - 1e-3).abs() < 1e-15 && n == (-1.0, 0.0));
     }

@@ -20,7 +20,7 @@ use nalgebra::Vector3;
 
 use super::contacts::{belongs_to, feature_radius, line_pair, line_samples, piece_rod, Rod};
 use super::features::{
-    circle_point, in_cone, periodic_minimum, segment_parameters, Feature, Placed, Sweep,
+    circle_minimum, circle_point, in_cone, segment_parameters, Feature, Placed, Sweep,
 };
 use crate::rigid::collision::ContactPoint;
 
@@ -39,14 +39,23 @@ type Candidate = (f64, V3, V3, V3, Feature);
 /// Edge circle `k` of the body against the segment `start + u t`, u ∈ (0, length):
 /// (distance, normal body → wall, point on the circle, point on the segment), `None` unless
 /// the foot is inside the segment and the normal in the circle's cone.
-fn circle_segment(x: &Placed, k: usize, start: &V3, t: &V3, length: f64) -> Option<(f64, V3, V3, V3)> {
+fn circle_segment(
+    x: &Placed,
+    k: usize,
+    start: &V3,
+    t: &V3,
+    length: f64,
+) -> Option<(f64, V3, V3, V3)> {
     let circle = x.shape.circles[k];
     let q0 = x.at(circle.z) - start;
     let r = circle.r;
-    let (a0, ac, as_) = (q0.norm_squared() + r * r, 2.0 * r * q0.dot(&x.x), 2.0 * r * q0.dot(&x.y));
+    let (a0, ac, as_) = (
+        q0.norm_squared() + r * r,
+        2.0 * r * q0.dot(&x.x),
+        2.0 * r * q0.dot(&x.y),
+    );
     let (b0, bc, bs) = (q0.dot(t), r * x.x.dot(t), r * x.y.dot(t));
-    let eval = |theta: f64| -> (f64, f64, f64) {
-        let (s, c) = theta.sin_cos();
+    let eval = |c: f64, s: f64| -> (f64, f64, f64) {
         let av = a0 + ac * c + as_ * s;
         let da = -ac * s + as_ * c;
         let bv = b0 + bc * c + bs * s;
@@ -57,8 +66,18 @@ fn circle_segment(x: &Placed, k: usize, start: &V3, t: &V3, length: f64) -> Opti
             -(av - a0) - 2.0 * (db * db - bv * (bv - b0)),
         )
     };
-    let (theta, _) = periodic_minimum(8, eval);
-    let (p, _, tangent) = circle_point(x, k, theta);
+    // nearly parallel to the axis, the edge faces the circle where it passes nearest
+    let centre = x.at(circle.z);
+    let guess = if x.axis.dot(t).abs() > 0.95 {
+        let w = start + t * (centre - start).dot(t) - centre;
+        let (c, s) = (w.dot(&x.x), w.dot(&x.y));
+        let n = c.hypot(s);
+        (n > 0.5 * r).then(|| (c / n, s / n))
+    } else {
+        None
+    };
+    let (u, _) = circle_minimum(guess, eval);
+    let (p, _, tangent) = circle_point(x, k, u);
     let u = (p - start).dot(t);
     if !(u > 0.0 && u < length) {
         return None;
@@ -113,7 +132,13 @@ fn edge_piece(body: &Placed, i: usize, rod: &Rod, inward: &[V3]) -> Option<Candi
         if length > 1e-15 {
             let u = d / length;
             let radius = sweep.radius(sigma);
-            consider((length - radius, u, on_edge, centre - u * radius, Feature::Side(i)));
+            consider((
+                length - radius,
+                u,
+                on_edge,
+                centre - u * radius,
+                Feature::Side(i),
+            ));
         }
     }
     for &k in &body.shape.frustums[i].circles {
@@ -213,7 +238,7 @@ pub fn edge_contacts(
             normal: c.1,
             overlap: -c.0,
             radius_first: f64::INFINITY,
-            radius_second: feature_radius(body, c.4, &c.3, &(-c.1)),
+            radius_second: feature_radius(body, c.4, &c.3),
             feature_first: key,
             feature_second: c.4.key(),
         });
@@ -223,7 +248,9 @@ pub fn edge_contacts(
         let piece = piece_rod(body, i);
         for sample in line_samples(&piece, &rod, gh, lo, hi, sigma) {
             // the sample's normal runs from the body to the edge
-            if sample.overlap > 0.0 && sample.weight > 0.0 && off_every_face(&(-sample.normal), inward)
+            if sample.overlap > 0.0
+                && sample.weight > 0.0
+                && off_every_face(&(-sample.normal), inward)
             {
                 out.push(ContactPoint {
                     point: sample.point,
@@ -297,10 +324,25 @@ pub fn polygon_edge_contacts(
     let n = vertices.len();
     for e in 0..n {
         let (va, vb) = (vertices[e], vertices[(e + 1) % n]);
-        edge_contacts(&va, &vb, &edge_normals[e..e + 1], EDGE_KEY + e as u64, body, out, weights);
+        edge_contacts(
+            &va,
+            &vb,
+            &edge_normals[e..e + 1],
+            EDGE_KEY + e as u64,
+            body,
+            out,
+            weights,
+        );
     }
     for m in 0..n {
         let neighbours = [vertices[(m + 1) % n], vertices[(m + n - 1) % n]];
-        corner_contact(&vertices[m], &neighbours, CORNER_KEY + m as u64, body, out, weights);
+        corner_contact(
+            &vertices[m],
+            &neighbours,
+            CORNER_KEY + m as u64,
+            body,
+            out,
+            weights,
+        );
     }
 }

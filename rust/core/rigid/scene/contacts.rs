@@ -89,7 +89,10 @@ pub(super) fn plane_object(plane: usize) -> u64 {
 impl RigidScene {
     /// Note that bodies (or a body and a boundary) touch under `key`; log an onset when they
     /// did not touch at the previous evaluation. `relative` is the velocity of the second
-    /// surface minus the first at the deepest point, whose normal is `normal`.
+    /// surface minus the first at the deepest point `point`, whose normal is `normal`;
+    /// `logged_normal` is the normal the log keeps (from the wall to the body, or from the
+    /// lower body index to the higher).
+    #[allow(clippy::too_many_arguments)]
     fn note_touch(
         &mut self,
         key: u64,
@@ -99,6 +102,8 @@ impl RigidScene {
         time: f64,
         relative: &Vector3<f64>,
         normal: &Vector3<f64>,
+        point: &Vector3<f64>,
+        logged_normal: &Vector3<f64>,
     ) {
         self.touching_next.insert(key);
         if partner_is_wall {
@@ -121,6 +126,10 @@ impl RigidScene {
                 partner_is_wall,
                 normal_speed: -v_n,
                 tangential_speed: (relative - normal * v_n).norm(),
+                point: *point,
+                normal: *logged_normal,
+                body_pose: self.pose(first),
+                partner_pose: (!partner_is_wall).then(|| self.pose(second)),
             });
         }
     }
@@ -267,6 +276,8 @@ impl RigidScene {
                     time,
                     &relative0,
                     &c0.normal,
+                    &c0.point,
+                    &c0.normal,
                 );
                 for c in &contacts {
                     max_overlap = max_overlap.max(c.overlap);
@@ -388,6 +399,8 @@ impl RigidScene {
                 let c0 = contacts[deepest];
                 let relative0 = self.bodies.point_velocity(second, &c0.point)
                     - self.bodies.point_velocity(first, &c0.point);
+                // the normal of `first` → `second`, as `a` → `b` for the log
+                let normal0 = if first == a { c0.normal } else { -c0.normal };
                 self.note_touch(
                     (a as u64) << 32 | b as u64,
                     a,
@@ -396,6 +409,8 @@ impl RigidScene {
                     time,
                     &relative0,
                     &c0.normal,
+                    &c0.point,
+                    &normal0,
                 );
                 count += contacts.len();
                 for c in &contacts {

@@ -20,19 +20,17 @@
 
 use nalgebra::{UnitQuaternion, Vector3};
 
-use super::{PreparedShape, RigidOnset, RigidScene};
+use super::revolution_geometry::{frames, Block};
+use super::{RigidOnset, RigidScene};
 use crate::contact::effective_mass;
 use crate::error::{DemfemError, Result};
-use crate::rigid::collision::{
-    clump_clump_contacts, clump_mesh_contacts, clump_plane_contacts, clump_polygon_contacts,
-    BodyPose, ClumpPairScratch, ContactPoint, Plane,
-};
-use crate::rigid::revolution::contacts::{bead_contact, pair_contacts, plane_contacts, PairScratch};
-use crate::rigid::revolution::features::Placed;
-use crate::rigid::revolution::wall_edges::polygon_edge_contacts;
-use crate::rigid::shape::RigidShape;
+use crate::rigid::collision::{BodyPose, ContactPoint};
 
 type V3 = Vector3<f64>;
+
+/// Bodies below which the contact geometry stays on one thread (a block would be too small
+/// to pay for the hand-over).
+const PARALLEL_MIN_BODIES: usize = 64;
 
 /// A Mindlin spring of one contact: (feature on the first object, feature on the second, ξ).
 type Spring = (u64, u64, V3);
@@ -50,11 +48,11 @@ pub(crate) struct RevolutionPass {
     pair_touching: Vec<bool>,
     wall_range: Vec<(u32, u32)>,
     wall_touching: Vec<bool>,
-    contacts: Vec<ContactPoint>,
-    weights: Vec<f64>,
-    pair_scratch: PairScratch,
-    clump_scratch: ClumpPairScratch,
+    wall_blocks: Vec<Block>,
+    pair_blocks: Vec<Block>,
     rebuilds: u64,
+    /// Each body's axis, x and y in the world for this evaluation.
+    frames: Vec<[V3; 3]>,
     /// The deepest overlap of the last evaluation: (body, partner, partner is a boundary,
     /// overlap m).
     deepest: Option<(usize, usize, bool, f64)>,
@@ -67,25 +65,16 @@ impl RevolutionPass {
     }
 }
 
-fn placed<'a>(shape: &'a crate::rigid::RevolutionShape, pose: &BodyPose) -> Placed<'a> {
-    let q = pose.orientation;
-    Placed {
-        shape,
-        origin: pose.position,
-        axis: q * Vector3::z(),
-        x: q * Vector3::x(),
-        y: q * Vector3::y(),
-    }
-}
-
 /// A body's bounding capsule inflated by half the skin, and the box around it: (lower x,
 /// upper x, lower corner, upper corner, axis start, axis end, radius, body).
 type CapsuleBox = (f64, f64, V3, V3, V3, V3, f64, u32);
 
-/// Rotation angle between two orientations, rad.
-fn rotation_angle(a: &UnitQuaternion<f64>, b: &UnitQuaternion<f64>) -> f64 {
-    let d = a.inverse() * b;
-    2.0 * d.imag().norm().atan2(d.w.abs())
+/// An upper bound of the rotation angle between two orientations, rad: with the nearer
+/// of ±b, |a − b| = 2 sin(θ/4) ≥ θ/π·√2 for θ ≤ π, so θ ≤ 2.23 |a − b|.
+fn rotation_bound(a: &UnitQuaternion<f64>, b: &UnitQuaternion<f64>) -> f64 {
+    let (qa, qb) = (a.coords, b.coords);
+    let d = (qa - qb).norm().min((qa + qb).norm());
+    2.23 * d
 }
 
 impl RigidScene {
@@ -127,7 +116,7 @@ impl RigidScene {
                 let (x0, q0) = pass.reference[i];
                 let r = self.shapes[self.body_shape[i]].0.bounding_radius();
                 (self.bodies.position[i] - x0).norm()
-                    + r * rotation_angle(&q0, &self.bodies.orientation[i])
+                    + r * rotation_bound(&q0, &self.bodies.orientation[i])
                     > 0.5 * pass.skin
             });
         if !stale {
@@ -228,8 +217,7 @@ impl RigidScene {
     fn revolution_contacts(&mut self, pass: &mut RevolutionPass, time: f64) -> Result<()> {
         let n = self.bodies.len();
         let dt = self.time_step;
-        let n_planes = self.planes.len();
-        let n_boundaries = n_planes + self.walls.len();
+        let n_boundaries = self.planes.len() + self.walls.len();
         let offsets: Vec<(V3, V3)> = self
             .walls
             .iter()
@@ -238,10 +226,48 @@ impl RigidScene {
                 (Vector3::new(x.x, x.y, x.z), Vector3::new(v.x, v.y, v.z))
             })
             .collect();
-        if pass.wall_range.len() != n * n_boundaries {
-            pass.wall_range.resize(n * n_boundaries, (0, 0));
-            pass.wall_touching.resize(n * n_boundaries, false);
-        }
+        frames(&self.bodies.orientation, &mut pass.frames);
+        // the geometry, in blocks of bodies and of pairs (on the scene's threads)
+        let blocks = match &self.pool {
+            Some(pool) if n >= PARALLEL_MIN_BODIES => pool.current_num_threads(),
+            _ => 1,
+        };
+        pass.wall_blocks.resize_with(blocks, Block::default);
+        pass.pair_blocks.resize_with(blocks, Block::default);
+        let view = self.view();
+        let pairs = &pass.pairs;
+        let frames_now = &pass.frames;
+        let cut = |count: usize, b: usize| (count * b / blocks)..(count * (b + 1) / blocks);
+        let run = |(b, (walls, pair)): (usize, (&mut Block, &mut Block))| -> Result<()> {
+            walls.clear();
+            pair.clear();
+            view.wall_geometry(cut(n, b), frames_now, &offsets, walls)?;
+            view.pair_geometry(pairs, cut(pairs.len(), b), frames_now, pair)
+        };
+        let jobs = pass
+            .wall_blocks
+            .iter_mut()
+            .zip(pass.pair_blocks.iter_mut())
+            .enumerate();
+        match (&self.pool, blocks) {
+            (Some(pool), b) if b > 1 => pool.install(|| {
+                use rayon::prelude::*;
+                jobs.collect::<Vec<_>>()
+                    .into_par_iter()
+                    .map(run)
+                    .collect::<Result<Vec<()>>>()
+            })?,
+            _ => jobs.map(run).collect::<Result<Vec<()>>>()?,
+        };
+        // the forces, slot by slot in a fixed order
+        let old_wall_range = std::mem::take(&mut pass.wall_range);
+        let was_touching_wall = std::mem::take(&mut pass.wall_touching);
+        pass.wall_range = vec![(0, 0); n * n_boundaries];
+        pass.wall_touching = vec![false; n * n_boundaries];
+        let old_pair_range = std::mem::take(&mut pass.pair_range);
+        let was_touching_pair = std::mem::take(&mut pass.pair_touching);
+        pass.pair_range = vec![(0, 0); pass.pairs.len()];
+        pass.pair_touching = vec![false; pass.pairs.len()];
         pass.springs_next.clear();
         pass.deepest = None;
         self.coordination.iter_mut().for_each(|c| *c = 0);
@@ -249,97 +275,36 @@ impl RigidScene {
         let mut count = 0;
         let mut max_overlap: f64 = 0.0;
         let mut elastic_energy = 0.0;
-        let mut contacts = std::mem::take(&mut pass.contacts);
-        let mut weights = std::mem::take(&mut pass.weights);
-        for i in 0..n {
-            if !self.alive[i] {
-                continue;
-            }
-            let pose = self.pose(i);
-            for p in 0..n_boundaries {
-                contacts.clear();
-                weights.clear();
-                let shape = &self.shapes[self.body_shape[i]].0;
-                let (plane_point, plane_normal, surface_velocity, prepared) = if p < n_planes {
-                    let plane = self.planes[p];
-                    (plane.point, plane.normal, plane.surface_velocity, None)
-                } else {
-                    let wall = &self.walls[p - n_planes];
-                    let (offset, velocity) = offsets[p - n_planes];
-                    let (point, normal) = match &wall.shape {
-                        PreparedShape::Plane { point, normal } => (point + offset, *normal),
-                        _ => (offset, Vector3::z()),
-                    };
-                    (point, normal, wall.surface_velocity + velocity, Some((wall, offset)))
-                };
-                match (prepared.map(|(w, o)| (&w.shape, o)), shape) {
-                    (None | Some((PreparedShape::Plane { .. }, _)), RigidShape::Clump(clump)) => {
-                        let plane = Plane {
-                            point: plane_point,
-                            normal: plane_normal,
-                            surface_velocity: Vector3::zeros(),
-                        };
-                        clump_plane_contacts(&plane, clump, &pose, &mut contacts);
-                    }
-                    (None | Some((PreparedShape::Plane { .. }, _)), RigidShape::Revolution(r)) => {
-                        let body = placed(r, &pose);
-                        if plane_normal.dot(&(pose.position - plane_point)) < r.bounding_radius {
-                            plane_contacts(
-                                &plane_point,
-                                &plane_normal,
-                                &body,
-                                None,
-                                &mut contacts,
-                                &mut weights,
-                            );
-                        }
-                    }
-                    (Some((PreparedShape::Polygon(polygon), offset)), RigidShape::Clump(clump)) => {
-                        clump_polygon_contacts(polygon, &offset, clump, &pose, &mut contacts)
-                    }
-                    (Some((PreparedShape::Polygon(polygon), offset)), RigidShape::Revolution(r)) => {
-                        polygon_contacts(polygon, &offset, r, &pose, &mut contacts, &mut weights);
-                    }
-                    (Some((PreparedShape::Mesh(mesh), offset)), RigidShape::Clump(clump)) => {
-                        clump_mesh_contacts(mesh, &offset, clump, &pose, &mut contacts)
-                    }
-                    (Some((PreparedShape::Mesh(mesh), offset)), RigidShape::Revolution(r)) => {
-                        crate::rigid::revolution::mesh_walls::mesh_contacts(
-                            mesh,
-                            &offset,
-                            &placed(r, &pose),
-                            &mut contacts,
-                            &mut weights,
-                        )
-                    }
-                    (_, RigidShape::Exact(_)) => return Err(mixed_exact()),
-                }
-                weights.resize(contacts.len(), 1.0);
-                let slot = i * n_boundaries + p;
-                let old = pass.wall_range[slot];
+        let wall_blocks = std::mem::take(&mut pass.wall_blocks);
+        for block in &wall_blocks {
+            for touch in &block.touches {
+                let (i, p) = (touch.slot / n_boundaries, touch.slot % n_boundaries);
+                let contacts = &block.contacts[touch.range.0..touch.range.1];
+                let weights = &block.weights[touch.range.0..touch.range.1];
+                let old = old_wall_range.get(touch.slot).copied().unwrap_or((0, 0));
                 let start = pass.springs_next.len() as u32;
-                if contacts.is_empty() {
-                    pass.wall_range[slot] = (start, start);
-                    pass.wall_touching[slot] = false;
-                    continue;
-                }
                 count += contacts.len();
                 self.wall_contacts[i] += 1;
                 let m_star = self.bodies.mass[i] / contacts.len() as f64;
-                let deepest = deepest_of(&contacts);
-                if !pass.wall_touching[slot] && self.record_onsets {
-                    let c0 = contacts[deepest];
-                    let relative = self.bodies.point_velocity(i, &c0.point) - surface_velocity;
-                    self.onsets.push(onset(time, i, p, true, &relative, &c0.normal));
+                let deepest = deepest_of(contacts);
+                let c0 = contacts[deepest];
+                let touched = was_touching_wall.get(touch.slot).copied().unwrap_or(false);
+                if !touched && self.record_onsets {
+                    let relative =
+                        self.bodies.point_velocity(i, &c0.point) - touch.surface_velocity;
+                    let mut o = onset(time, i, p, true, &relative, &c0.normal);
+                    o.point = c0.point;
+                    o.normal = c0.normal;
+                    o.body_pose = self.pose(i);
+                    self.onsets.push(o);
                 }
-                pass.wall_touching[slot] = true;
-                let overlap = contacts[deepest].overlap;
-                if pass.deepest.is_none_or(|d| overlap > d.3) {
-                    pass.deepest = Some((i, p, true, overlap));
+                pass.wall_touching[touch.slot] = true;
+                if pass.deepest.is_none_or(|d| c0.overlap > d.3) {
+                    pass.deepest = Some((i, p, true, c0.overlap));
                 }
-                for (c, &w) in contacts.iter().zip(&weights) {
+                for (c, &w) in contacts.iter().zip(weights) {
                     max_overlap = max_overlap.max(c.overlap);
-                    let relative = self.bodies.point_velocity(i, &c.point) - surface_velocity;
+                    let relative = self.bodies.point_velocity(i, &c.point) - touch.surface_velocity;
                     let (f, energy) = self.spring_force(
                         pass,
                         old,
@@ -354,113 +319,70 @@ impl RigidScene {
                     self.bodies.force[i] += f;
                     self.bodies.torque[i] += (c.point - self.bodies.position[i]).cross(&f);
                 }
-                pass.wall_range[slot] = (start, pass.springs_next.len() as u32);
+                pass.wall_range[touch.slot] = (start, pass.springs_next.len() as u32);
             }
         }
-        for k in 0..pass.pairs.len() {
-            let (a, b) = (pass.pairs[k].0 as usize, pass.pairs[k].1 as usize);
-            let old = pass.pair_range[k];
-            let start = pass.springs_next.len() as u32;
-            pass.pair_range[k] = (start, start);
-            if !(self.alive[a] && self.alive[b]) {
-                pass.pair_touching[k] = false;
-                continue;
-            }
-            contacts.clear();
-            weights.clear();
-            let (pa, pb) = (self.pose(a), self.pose(b));
-            let (shape_a, shape_b) = (
-                &self.shapes[self.body_shape[a]].0,
-                &self.shapes[self.body_shape[b]].0,
-            );
-            let reach = shape_a.bounding_radius() + shape_b.bounding_radius();
-            let mut flipped = false;
-            if (pb.position - pa.position).norm() < reach
-                && super::contacts::capsules_overlap(
-                    &shape_a.bounding_capsule(),
-                    &pa,
-                    &shape_b.bounding_capsule(),
-                    &pb,
-                )
-            {
-                match (shape_a, shape_b) {
-                    (RigidShape::Revolution(ra), RigidShape::Revolution(rb)) => pair_contacts(
-                        &placed(ra, &pa),
-                        &placed(rb, &pb),
-                        &mut pass.pair_scratch,
-                        &mut contacts,
-                        &mut weights,
-                    ),
-                    (RigidShape::Clump(ca), RigidShape::Revolution(rb)) => {
-                        beads_against(ca, &pa, &placed(rb, &pb), &mut contacts)
-                    }
-                    (RigidShape::Revolution(ra), RigidShape::Clump(cb)) => {
-                        flipped = true;
-                        beads_against(cb, &pb, &placed(ra, &pa), &mut contacts)
-                    }
-                    (RigidShape::Clump(ca), RigidShape::Clump(cb)) => clump_clump_contacts(
-                        ca,
-                        &pa,
-                        cb,
-                        &pb,
-                        &mut pass.clump_scratch,
-                        &mut contacts,
-                    ),
-                    _ => return Err(mixed_exact()),
+        pass.wall_blocks = wall_blocks;
+        let pair_blocks = std::mem::take(&mut pass.pair_blocks);
+        for block in &pair_blocks {
+            for touch in &block.touches {
+                let k = touch.slot;
+                let (a, b) = (pass.pairs[k].0 as usize, pass.pairs[k].1 as usize);
+                let contacts = &block.contacts[touch.range.0..touch.range.1];
+                let weights = &block.weights[touch.range.0..touch.range.1];
+                let old = old_pair_range.get(k).copied().unwrap_or((0, 0));
+                let start = pass.springs_next.len() as u32;
+                let (first, second) = if touch.flipped { (b, a) } else { (a, b) };
+                let sharing: f64 = weights.iter().sum();
+                let m_star =
+                    effective_mass(self.bodies.mass[first], self.bodies.mass[second])? / sharing;
+                let c0 = contacts[deepest_of(contacts)];
+                let touched = was_touching_pair.get(k).copied().unwrap_or(false);
+                if !touched && self.record_onsets {
+                    let relative = self.bodies.point_velocity(second, &c0.point)
+                        - self.bodies.point_velocity(first, &c0.point);
+                    let mut o = onset(time, a, b, false, &relative, &c0.normal);
+                    o.point = c0.point;
+                    // logged from the lower index (a) to the higher
+                    o.normal = if first == a { c0.normal } else { -c0.normal };
+                    o.body_pose = self.pose(a);
+                    o.partner_pose = Some(self.pose(b));
+                    self.onsets.push(o);
                 }
+                pass.pair_touching[k] = true;
+                if pass.deepest.is_none_or(|d| c0.overlap > d.3) {
+                    pass.deepest = Some((a, b, false, c0.overlap));
+                }
+                self.coordination[a] += 1;
+                self.coordination[b] += 1;
+                count += contacts.len();
+                for (c, &w) in contacts.iter().zip(weights) {
+                    max_overlap = max_overlap.max(c.overlap);
+                    let relative = self.bodies.point_velocity(second, &c.point)
+                        - self.bodies.point_velocity(first, &c.point);
+                    let (f, energy) = self.spring_force(
+                        pass,
+                        old,
+                        c,
+                        &relative,
+                        m_star / w,
+                        self.model.e_star_body_body,
+                        dt,
+                    )?;
+                    elastic_energy += w * energy;
+                    let f = f * w;
+                    let arm_second = c.point - self.bodies.position[second];
+                    let arm_first = c.point - self.bodies.position[first];
+                    self.bodies.force[second] += f;
+                    self.bodies.torque[second] += arm_second.cross(&f);
+                    self.bodies.force[first] -= f;
+                    self.bodies.torque[first] -= arm_first.cross(&f);
+                }
+                pass.pair_range[k] = (start, pass.springs_next.len() as u32);
             }
-            if contacts.is_empty() {
-                pass.pair_touching[k] = false;
-                continue;
-            }
-            weights.resize(contacts.len(), 1.0);
-            let (first, second) = if flipped { (b, a) } else { (a, b) };
-            let sharing: f64 = weights.iter().sum();
-            let m_star = effective_mass(self.bodies.mass[first], self.bodies.mass[second])? / sharing;
-            let deepest = deepest_of(&contacts);
-            if !pass.pair_touching[k] && self.record_onsets {
-                let c0 = contacts[deepest];
-                let relative = self.bodies.point_velocity(second, &c0.point)
-                    - self.bodies.point_velocity(first, &c0.point);
-                let mut o = onset(time, a, b, false, &relative, &c0.normal);
-                o.partner = b as u32;
-                self.onsets.push(o);
-            }
-            pass.pair_touching[k] = true;
-            let overlap = contacts[deepest].overlap;
-            if pass.deepest.is_none_or(|d| overlap > d.3) {
-                pass.deepest = Some((a, b, false, overlap));
-            }
-            self.coordination[a] += 1;
-            self.coordination[b] += 1;
-            count += contacts.len();
-            for (c, &w) in contacts.iter().zip(&weights) {
-                max_overlap = max_overlap.max(c.overlap);
-                let relative = self.bodies.point_velocity(second, &c.point)
-                    - self.bodies.point_velocity(first, &c.point);
-                let (f, energy) = self.spring_force(
-                    pass,
-                    old,
-                    c,
-                    &relative,
-                    m_star / w,
-                    self.model.e_star_body_body,
-                    dt,
-                )?;
-                elastic_energy += w * energy;
-                let f = f * w;
-                let arm_second = c.point - self.bodies.position[second];
-                let arm_first = c.point - self.bodies.position[first];
-                self.bodies.force[second] += f;
-                self.bodies.torque[second] += arm_second.cross(&f);
-                self.bodies.force[first] -= f;
-                self.bodies.torque[first] -= arm_first.cross(&f);
-            }
-            pass.pair_range[k] = (start, pass.springs_next.len() as u32);
         }
+        pass.pair_blocks = pair_blocks;
         std::mem::swap(&mut pass.springs, &mut pass.springs_next);
-        pass.contacts = contacts;
-        pass.weights = weights;
         self.contacts_last_step = count;
         self.max_overlap_last_step = max_overlap;
         self.elastic_energy_last_step = elastic_energy;
@@ -495,66 +417,10 @@ impl RigidScene {
             .model
             .force_and_energy(c, relative, m_star, e_star, &mut xi, dt)?;
         if with_history {
-            pass.springs_next.push((c.feature_first, c.feature_second, xi));
+            pass.springs_next
+                .push((c.feature_first, c.feature_second, xi));
         }
         Ok(out)
-    }
-}
-
-/// A polygon wall displaced by `offset` against a body of revolution: the face (anchored
-/// points of the edge circles inside the polygon, on the side of the body's centre), then
-/// the edges and corners.
-fn polygon_contacts(
-    polygon: &crate::rigid::PolygonWall,
-    offset: &V3,
-    shape: &crate::rigid::RevolutionShape,
-    pose: &BodyPose,
-    contacts: &mut Vec<ContactPoint>,
-    weights: &mut Vec<f64>,
-) {
-    let (vertices, normal, edge_normals) = polygon.parts();
-    if vertices.is_empty() {
-        return;
-    }
-    let to_na = |v: &crate::geometry::Vec3| Vector3::new(v.x, v.y, v.z);
-    let world: Vec<V3> = vertices.iter().map(|v| to_na(v) + offset).collect();
-    let inward: Vec<V3> = edge_normals.iter().map(to_na).collect();
-    let mut n = to_na(&normal);
-    let side = n.dot(&(pose.position - world[0]));
-    if side.abs() >= shape.bounding_radius {
-        return;
-    }
-    if side < 0.0 {
-        n = -n;
-    }
-    let body = placed(shape, pose);
-    let inside = |x: &V3| {
-        world
-            .iter()
-            .zip(&inward)
-            .all(|(v, e)| e.dot(&(x - v)) >= 0.0)
-    };
-    plane_contacts(&world[0], &n, &body, Some(&inside), contacts, weights);
-    polygon_edge_contacts(&world, &inward, &body, contacts, weights);
-}
-
-/// The beads of a clump against a body of revolution (clump first).
-fn beads_against(
-    clump: &crate::rigid::BeadClump,
-    pose: &BodyPose,
-    body: &Placed,
-    contacts: &mut Vec<ContactPoint>,
-) {
-    let local = pose.orientation.inverse_transform_vector(&(body.origin - pose.position));
-    for (k, (c, &r)) in clump.centers.iter().zip(&clump.radii).enumerate() {
-        if (c - local).norm() >= body.shape.bounding_radius + r {
-            continue;
-        }
-        let centre = pose.position + pose.orientation * c;
-        if let Some(mut contact) = bead_contact(&centre, r, body) {
-            contact.feature_first = k as u64;
-            contacts.push(contact);
-        }
     }
 }
 
@@ -568,7 +434,14 @@ fn deepest_of(contacts: &[ContactPoint]) -> usize {
     deepest
 }
 
-fn onset(time: f64, body: usize, partner: usize, wall: bool, relative: &V3, normal: &V3) -> RigidOnset {
+fn onset(
+    time: f64,
+    body: usize,
+    partner: usize,
+    wall: bool,
+    relative: &V3,
+    normal: &V3,
+) -> RigidOnset {
     let v_n = relative.dot(normal);
     RigidOnset {
         time,
@@ -577,14 +450,12 @@ fn onset(time: f64, body: usize, partner: usize, wall: bool, relative: &V3, norm
         partner_is_wall: wall,
         normal_speed: -v_n,
         tangential_speed: (relative - normal * v_n).norm(),
-    }
-}
-
-fn mixed_exact() -> DemfemError {
-    DemfemError::ShapeMismatch {
-        field: "shape".into(),
-        detail: "bodies of revolution share a scene with bead clumps and spheres, not with \
-                 parry exact shapes"
-            .into(),
+        point: Vector3::zeros(),
+        normal: *normal,
+        body_pose: BodyPose {
+            position: Vector3::zeros(),
+            orientation: UnitQuaternion::identity(),
+        },
+        partner_pose: None,
     }
 }
