@@ -33,11 +33,8 @@ synthetic heavy-tailed replicas. SI units; rates per hour.
 """
 from __future__ import annotations
 
-import dataclasses
 import itertools
 import math
-import shutil
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Mapping, Optional, Sequence
@@ -291,36 +288,17 @@ def replica_point(params: dict) -> dict:
     ``window_s`` and ``seed`` (:func:`demfem.assess.replica_stats.replica_numbers`)."""
     from demfem.assess import run as assess_run
     from demfem.assess.replica_stats import replica_numbers
-    from demfem.assess.sweep_runner import _KEYS
-    from demfem.scenes.table import AccumulationTable
-    from demfem.sweep import run_key
+    from demfem.assess.sweep_runner import SweepPoint, sweep_point
 
-    p = dict(params)
-    seed = check_count("seed", p.pop("seed", 0), 0)
-    raw = p.pop("duration", None)
-    raw_q = p.pop("throughput", None)
-    run_dir = p.pop("run_dir", None)
-    fields = {f.name for f in dataclasses.fields(AccumulationTable)}
-    unknown = sorted(set(p) - fields)
-    if unknown:
-        raise InvalidParameterError(
-            f"invalid sweep parameter(s) {unknown}: allowed are seed, duration, throughput, "
-            f"run_dir and the table's fields {sorted(fields)}")
-    table = dataclasses.replace(AccumulationTable(), **p)
-    tmp = None if run_dir is not None else tempfile.mkdtemp(prefix="demfem_replica_")
-    out = Path(tmp) if tmp is not None else Path(run_dir) / run_key(params)
+    point = sweep_point(params, ("seed",), prefix="demfem_replica_")
     try:
-        settings: dict[str, Any] = {
-            "seed": seed, "duration": None if raw is None else float(raw),
-            "throughput": None if raw_q is None else float(raw_q)}
-        risk = assess_run.assess(table, out=out, stop_after="risk", log=lambda line: None,
-                                 **settings)
+        seed = check_count("seed", point.extra.get("seed", 0), 0)
+        risk = assess_run.assess(point.table, out=point.out, stop_after="risk",
+                                 log=lambda line: None, seed=seed, duration=point.duration,
+                                 throughput=point.throughput)
     finally:
-        if tmp is not None:
-            shutil.rmtree(tmp, ignore_errors=True)
-    s = risk["summary"]
-    res: dict[str, Any] = {k: s[k] for k in _KEYS if k in s}
-    res["steady"] = bool(risk["steady_state"]["steady"])
+        point.remove_temporary()
+    res = SweepPoint.numbers(risk)
     nums = replica_numbers(risk)
     res.update(seed=seed, expected_broken=nums["expected_broken"], hours=nums["hours"],
                window_s=nums["window_s"])
