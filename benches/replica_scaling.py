@@ -17,14 +17,11 @@ just before each set, the machine and its load.
 
 The replicas are a small table (``--spheres`` cartridges) so that a repeat takes seconds; a
 replica of the default job is minutes, over which the per-replica overhead (worker start,
-imports, the calibration stage) weighs less. If the installed demfem's assess has no
-``seed`` argument yet, the test scaffolding ``tests/python/replica_seed_shim.py`` supplies it
-(in this process and, as a worker preload, in the workers).
+imports, the calibration stage) weighs less.
 """
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import json
 import os
 import platform
@@ -35,18 +32,6 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "docs" / "data" / "replica_scaling.json"
-SHIM = ROOT / "tests" / "python" / "replica_seed_shim.py"
-
-
-def _seed_support() -> dict:
-    """Install the seed shim where needed; returns the Dask config that preloads it."""
-    spec = importlib.util.spec_from_file_location("_replica_seed_shim_bench", SHIM)
-    shim = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(shim)
-    if not shim.needed():
-        return {}
-    shim.install()
-    return {"distributed.worker.preload": [str(SHIM)]}
 
 
 def cpu_share(seconds: float = 1.0) -> float:
@@ -98,8 +83,6 @@ def one(table, workers: int, replicas: int, duration: float, where: Path) -> dic
 
 
 def main() -> None:
-    import dask
-    import distributed  # noqa: F401 - its config defaults in place before dask.config.set
 
     from demfem.scenes.table import AccumulationTable
 
@@ -112,11 +95,10 @@ def main() -> None:
     a = p.parse_args()
     table = AccumulationTable(width=0.1, length=0.1, tilted_wall_length=0.05,
                               n_spheres=a.spheres)
-    config = _seed_support()
     load_before = os.getloadavg()
     runs: dict[int, list[dict]] = {1: [], 2: []}
     started = time.perf_counter()
-    with dask.config.set(config), tempfile.TemporaryDirectory(prefix="replica_bench_") as tmp:
+    with tempfile.TemporaryDirectory(prefix="replica_bench_") as tmp:
         for rep in range(a.reps):
             for w in ((1, 2) if rep % 2 == 0 else (2, 1)):
                 share = cpu_share()

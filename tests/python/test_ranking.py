@@ -7,10 +7,8 @@ the sweep wiring (issue 41).
 in demfem/assess/ranking.py and docs/replicas.md (default 400 sweeps per cell)."""
 from __future__ import annotations
 
-import importlib.util
 import json
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -19,7 +17,6 @@ from demfem.assess.ranking import (TESTS, holm, paired_test, rank_setups, ranked
 from demfem.assess.replica_stats import simulate_replicas
 from demfem.errors import InvalidParameterError
 
-SHIM = Path(__file__).with_name("replica_seed_shim.py")
 
 
 def synthetic(rng, factors, replicas, periods=7, background=0.05):
@@ -145,13 +142,9 @@ def test_ranked_sweep_pairs_replicas_by_seed(tmp_path):
         ranked_sweep({"setup": ["a"]}, _paired_runner, tmp_path, 0, scheduler="serial")
 
 
-def test_ranked_sweep_of_risk_points_on_a_tiny_table(tmp_path, monkeypatch):
+def test_ranked_sweep_of_risk_points_on_a_tiny_table(tmp_path):
     """The risk runner through the sweep: 2 belt speeds × 2 paired replicas of a tiny table,
     every point's assessment kept (resumable) under out/points."""
-    spec = importlib.util.spec_from_file_location("_replica_seed_shim_rank", SHIM)
-    shim = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(shim)
-    shim.install(monkeypatch.setattr)
     grid = {"belt_velocity": [0.1, 0.3], "width": [0.1], "length": [0.1],
             "tilted_wall_length": [0.05], "n_spheres": [30], "duration": [0.05]}
     rk = ranked_sweep(grid, "demfem.assess.sweep_runner:risk_point", tmp_path, 2,

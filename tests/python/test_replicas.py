@@ -5,9 +5,7 @@ by simulation; bad input and faults (issue 41)."""
 from __future__ import annotations
 
 import dataclasses
-import importlib.util
 import json
-import math
 import re
 import shutil
 import time
@@ -25,42 +23,17 @@ from demfem.risk.interval import interval_from_blocks
 from demfem.scenes.perturb import perturbed_start, start_clearance
 from demfem.scenes.table import AccumulationTable
 
-SHIM = Path(__file__).with_name("replica_seed_shim.py")
 TINY = dict(width=0.1, length=0.1, tilted_wall_length=0.05, n_spheres=30)
 RUN = dict(duration=0.1, reports=False, log=lambda line: None)
-
-
-def _shim():
-    spec = importlib.util.spec_from_file_location("_replica_seed_shim_local", SHIM)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
-
-
-@pytest.fixture
-def seeded(monkeypatch):
-    """assess(seed=...) in this process (and, through the preload, in the workers) until
-    demfem's own assess has it."""
-    _shim().install(monkeypatch.setattr)
 
 
 @pytest.fixture(scope="module")
 def first_set(tmp_path_factory):
     """Two replicas of the tiny table on a LocalCluster of 2 workers: (folder, document,
     wall seconds)."""
-    import dask
-
-    mp = pytest.MonkeyPatch()
-    shim = _shim()
-    preload = {"distributed.worker.preload": [str(SHIM)]} if shim.needed() else {}
-    shim.install(mp.setattr)
     out = tmp_path_factory.mktemp("replicas") / "set"
     t0 = time.perf_counter()
-    try:
-        with dask.config.set(preload):
-            doc = assess_replicas(AccumulationTable(**TINY), out, 2, n_workers=2, **RUN)
-    finally:
-        mp.undo()
+    doc = assess_replicas(AccumulationTable(**TINY), out, 2, n_workers=2, **RUN)
     return out, doc, time.perf_counter() - t0
 
 
@@ -166,7 +139,7 @@ def test_two_replicas_on_a_local_cluster(first_set):
     assert m["n"] == 2 and m["dof"] == 1 and 0 < m["lower"] < m["estimate"] < m["upper"]
 
 
-def test_a_lost_replica_is_resumed_alone_with_the_same_numbers(first_set, tmp_path, seeded):
+def test_a_lost_replica_is_resumed_alone_with_the_same_numbers(first_set, tmp_path):
     out = _copy(first_set, tmp_path)
     first = first_set[1]["merged"]
     lost = out / "replica_1"
@@ -186,50 +159,41 @@ def test_a_killed_worker_is_retried_and_the_set_ends_with_the_same_numbers(first
     import signal
     import threading
 
-    import dask
     from distributed import Client, LocalCluster
 
-    mp = pytest.MonkeyPatch()
-    shim = _shim()
-    preload = {"distributed.worker.preload": [str(SHIM)]} if shim.needed() else {}
-    shim.install(mp.setattr)
     out = tmp_path / "set"
     got: dict = {}
-    try:
-        with dask.config.set(preload), LocalCluster(
-                n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
-                silence_logs=50) as cluster, Client(cluster) as client:
-            workers = set(client.run(os.getpid).values())
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+                      silence_logs=50) as cluster, Client(cluster) as client:
+        workers = set(client.run(os.getpid).values())
 
-            def run() -> None:
-                try:
-                    got["doc"] = assess_replicas(AccumulationTable(**TINY), out, 2,
-                                                 scheduler=cluster.scheduler_address, **RUN)
-                except Exception as exc:  # noqa: BLE001 - reported below
-                    got["error"] = exc
+        def run() -> None:
+            try:
+                got["doc"] = assess_replicas(AccumulationTable(**TINY), out, 2,
+                                             scheduler=cluster.scheduler_address, **RUN)
+            except Exception as exc:  # noqa: BLE001 - reported below
+                got["error"] = exc
 
-            thread = threading.Thread(target=run)
-            thread.start()
-            # the first replica to reach its DEM stage names its worker's process: kill it
-            deadline = time.perf_counter() + 30.0
-            logs: list = []
-            while not logs and time.perf_counter() < deadline:
-                logs = [p for p in sorted(out.glob("replica_*.log"))
-                        if "2/6 dem" in p.read_text()]
-                time.sleep(0.02)
-            victim = int(re.search(r"process (\d+)", logs[0].read_text()).group(1))
-            assert victim in workers
-            os.kill(victim, signal.SIGKILL)
-            thread.join(120.0)
-    finally:
-        mp.undo()
+        thread = threading.Thread(target=run)
+        thread.start()
+        # the first replica to reach its DEM stage names its worker's process: kill it
+        deadline = time.perf_counter() + 30.0
+        logs: list = []
+        while not logs and time.perf_counter() < deadline:
+            logs = [p for p in sorted(out.glob("replica_*.log"))
+                    if "2/6 dem" in p.read_text()]
+            time.sleep(0.02)
+        victim = int(re.search(r"process (\d+)", logs[0].read_text()).group(1))
+        assert victim in workers
+        os.kill(victim, signal.SIGKILL)
+        thread.join(120.0)
     assert "error" not in got, got.get("error")
     starts = logs[0].read_text().count("== replica_")
     assert starts == 2  # killed, then run again on a worker
     assert got["doc"]["merged"] == first_set[1]["merged"]
 
 
-def test_a_failed_replica_lets_the_others_finish(first_set, tmp_path, seeded):
+def test_a_failed_replica_lets_the_others_finish(first_set, tmp_path):
     out = _copy(first_set, tmp_path)
     (out / "replica_1" / "stages.json").write_text("{ damaged")
     with pytest.raises(ReplicaFailedError, match="replica_1"):
@@ -242,8 +206,7 @@ def test_a_failed_replica_lets_the_others_finish(first_set, tmp_path, seeded):
     assert doc["merged"] == first_set[1]["merged"] and not doc["failed"]
 
 
-def test_replicas_of_other_settings_are_refused_naming_the_difference(first_set, tmp_path,
-                                                                      seeded):
+def test_replicas_of_other_settings_are_refused_naming_the_difference(first_set, tmp_path):
     out = _copy(first_set, tmp_path)
     other = dict(RUN, duration=0.2)
     with pytest.raises(SettingsMismatchError, match=r"assess\.duration: 0\.1 -> 0\.2"):
@@ -257,7 +220,7 @@ def test_replicas_of_other_settings_are_refused_naming_the_difference(first_set,
         merge_replicas([a, b])
 
 
-def test_precision_adds_replicas_until_reached_or_max(first_set, tmp_path, seeded):
+def test_precision_adds_replicas_until_reached_or_max(first_set, tmp_path):
     out = _copy(first_set, tmp_path)
     lines: list[str] = []
     doc = assess_replicas(AccumulationTable(**TINY), out, 2, precision=1e-6, max_replicas=3,
