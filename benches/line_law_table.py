@@ -22,7 +22,7 @@ from demfem.contact import ContactBody, max_contact_force
 from demfem.fem.line_law import line_contact_stiffness
 from demfem.io.atomic import write_text_atomic
 from demfem.scenes import AccumulationTable
-from demfem.studies import run_table
+from demfem.dem.table_run import run_table
 
 
 def main() -> None:

@@ -51,7 +51,7 @@ def _warm() -> None:
 
     for name in ("demfem.assess.run", "demfem.assess.replicas", "demfem.assess.events",
                  "demfem.stress.stage", "demfem.assess.risk_product",
-                 "demfem.studies.table_run", "demfem.scenes.perturb"):
+                 "demfem.dem.table_run", "demfem.scenes.perturb"):
         importlib.import_module(name)
 
 

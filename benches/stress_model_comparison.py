@@ -45,7 +45,7 @@ def evaluate(out: Path, table, variant: dict) -> dict:
     from demfem.risk import INNER_SURFACE, OUTER_SURFACE, SCG_BOROSILICATE
     from demfem.risk.interval import hourly_interval_from_events
     from demfem.stress.stage import characteristic_flaw_depth, collision_stresses
-    from demfem.studies.table_run import TableRun
+    from demfem.dem.table_run import TableRun
 
     run = TableRun.load(out / "table_run.npz")
     ev = load_npz(out / "events.npz")["events"].astype(EVENT_DTYPE)

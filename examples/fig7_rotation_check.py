@@ -27,7 +27,7 @@ from demfem.dem import from_scene
 from demfem.io import savefig_atomic, write_json_atomic
 from demfem.scenes.table import Tag
 from demfem.studies.figures import FIG6_SETUP, SWEEP_GEOMETRY, speed_windows
-from demfem.studies.table_run import table_from_params
+from demfem.dem.table_run import table_from_params
 
 
 def main() -> None:

@@ -321,7 +321,7 @@ def _cmd_cluster(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from demfem.scenes.cluster import LOAD_CASES, CartridgeCluster, cluster_from_run
-    from demfem.studies.cluster_run import run_cluster
+    from demfem.fem.cluster_run import run_cluster
 
     overrides = {"springs": args.springs}
     if args.elements is not None:

@@ -18,7 +18,7 @@ The breakage risk of the table is ``demfem assess`` (:func:`demfem.assess.assess
 of the seven-cartridge cluster ``demfem cluster``; the run's log points to both.
 
 Outputs in ``out``: ``calibration.csv`` and ``calibration_force_vs_E.png``, ``table_run.npz``
-(the whole record, :class:`demfem.studies.table_run.TableRun`), ``collisions.csv`` (one row
+(the whole record, :class:`demfem.dem.table_run.TableRun`), ``collisions.csv`` (one row
 per contact onset), ``summary.json``, ``table_time_series.png``, ``collisions.png``,
 ``table_end.png``, a ParaView series ``vtk/table.pvd`` and ``run.json``, the folder's record
 (:class:`demfem.jobs.OutputFolder`: the command, the run's settings — the scene's TOML text
@@ -139,7 +139,7 @@ def run_pipeline(out: str | Path = "demfem_out/run", duration: float = 1.0,
     from demfem.jobs import OutputFolder
 
     # every argument checked before any work
-    from demfem.studies.table_run import check_run_arguments
+    from demfem.dem.table_run import check_run_arguments
 
     check_run_arguments(duration, sample_interval, threads)
     v_rel = check_positive("v_rel", v_rel)
@@ -164,7 +164,7 @@ def _run(folder, table, duration: float, sample_interval: float, threads: int, v
     from demfem.cartridge import Cartridge
     from demfem.io.strict_json import write_json_atomic
     from demfem.progress import ProgressBar
-    from demfem.studies.table_run import TableRun, checkpoint_state, run_table
+    from demfem.dem.table_run import TableRun, checkpoint_state, run_table
 
     out = folder.path
     complete = folder.fields.get("status") == "complete"
@@ -217,7 +217,7 @@ def _run(folder, table, duration: float, sample_interval: float, threads: int, v
         f"particle-steps/s), effects: {', '.join(info['effects'])}")
 
     # 3. analysis and figures
-    from demfem.studies.run_report import write_analysis
+    from demfem.run_report import write_analysis
 
     result = write_analysis(out, run, table, duration, discard, sample_interval, log)
     result = {"calibration": {"v_rel_m_per_s": v_rel, "young_modulus_Pa": cal.E.tolist(),

@@ -180,7 +180,7 @@ def test_toml_round_trip_and_bad_files(tmp_path):
 
 
 def test_tiny_run_writes_every_output(tmp_path):
-    from demfem.studies.cluster_run import run_cluster
+    from demfem.fem.cluster_run import run_cluster
 
     c = small(springs=True)
     out = tmp_path / "run"
@@ -250,7 +250,7 @@ def test_shell_cluster_geometry_and_tiny_run(tmp_path):
     surfaces (the mid-surfaces are t + gap apart), the shells sit half their end thickness
     up, springs sit on the mid-surface columns, and a tiny run writes the outputs (σ1 on
     the inner and outer faces; no VTK files)."""
-    from demfem.studies.cluster_run import run_cluster
+    from demfem.fem.cluster_run import run_cluster
 
     c = small(springs=True, elements="shell")
     p = c.parts()

@@ -16,7 +16,7 @@ from demfem.stress.stress_model import StressModel
 from demfem.stress.stage import collision_stresses
 from demfem.dem import DemSimulation, material
 from demfem.scenes import AccumulationTable
-from demfem.studies import run_table
+from demfem.dem.table_run import run_table
 
 TINY = dict(width=0.1, length=0.1, tilted_wall_length=0.08, opening_width=0.03,
             gate_amplitude=0.01, gate_period=0.2, belt_velocity=0.5, young_modulus=1e7,

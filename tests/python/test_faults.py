@@ -13,7 +13,7 @@ from demfem import _core, dem
 from demfem.errors import (CheckpointError, InvalidParameterError, NumericalError,
                            SettingsMismatchError, SimulationInterrupted, check_count)
 from demfem.scenes.table import AccumulationTable
-from demfem.studies.table_run import checkpoint_files, run_table
+from demfem.dem.table_run import checkpoint_files, run_table
 
 R = 0.008
 GLASS = dem.material(45e9, 0.22, 2230.0)  # frictionless, elastic: effect "gravity" only
@@ -355,7 +355,7 @@ def _tiny_cluster(young_modulus: float = 1e8):
 
 def _cluster_checkpoint(out, monkeypatch):
     """A cluster run stopped just after its first checkpoint."""
-    from demfem.studies import cluster_run
+    from demfem.fem import cluster_run
 
     save = cluster_run._save_checkpoint
 
@@ -379,7 +379,7 @@ def _flip(path, at=None):
 
 @pytest.mark.parametrize("which", ["checkpoint.state", "checkpoint.npz"])
 def test_a_flipped_bit_in_the_cluster_checkpoint_is_refused_by_name(tmp_path, monkeypatch, which):
-    from demfem.studies.cluster_run import run_cluster
+    from demfem.fem.cluster_run import run_cluster
 
     _cluster_checkpoint(tmp_path, monkeypatch)
     _flip(tmp_path / which)
@@ -389,7 +389,7 @@ def test_a_flipped_bit_in_the_cluster_checkpoint_is_refused_by_name(tmp_path, mo
 
 
 def test_a_rewritten_cluster_run_npz_is_refused_by_name(tmp_path, monkeypatch):
-    from demfem.studies import cluster_run
+    from demfem.fem import cluster_run
 
     monkeypatch.setattr(cluster_run, "_write_outputs", lambda *args: {})  # figures: slow
     cluster_run.run_cluster(_tiny_cluster(), duration=3e-4, out=tmp_path, progress=False,
@@ -405,7 +405,7 @@ def test_a_rewritten_cluster_run_npz_is_refused_by_name(tmp_path, monkeypatch):
 
 
 def test_a_cluster_without_the_impact_it_was_set_up_for_is_a_numerical_error(tmp_path):
-    from demfem.studies.cluster_run import run_cluster
+    from demfem.fem.cluster_run import run_cluster
 
     # E = 1e3 Pa: a step of 0.5 ms, six steps in 3 ms, no contact force at all
     with pytest.raises(NumericalError, match=r"no contact between cartridges 1 and 2.*0 N.*"
@@ -511,7 +511,7 @@ def test_the_shell_mesher_refuses_a_huge_mesh_naming_target_size():
 
 
 def test_a_damaged_table_run_file_is_refused_by_name(tmp_path):
-    from demfem.studies.table_run import TableRun
+    from demfem.dem.table_run import TableRun
 
     path = tmp_path / "table_run.npz"
     path.write_bytes(b"PK\x03\x04" + bytes(200))

@@ -109,7 +109,7 @@ def test_the_fem_line_law_is_named_in_scene_files_and_refused_by_assess(tmp_path
     loads)."""
     from demfem.assess import assess
     from demfem.scenes import AccumulationTable
-    from demfem.studies import run_table
+    from demfem.dem.table_run import run_table
 
     small = AccumulationTable(width=0.1, length=0.1, tilted_wall_length=0.05, n_spheres=30,
                               contact_model="fem_line")

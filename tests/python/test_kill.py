@@ -21,7 +21,7 @@ ASSESS = ("import sys; from demfem.assess import assess; "
           "assess(out=sys.argv[1], duration=0.12, checkpoint_every=0.3, log=lambda s: None)")
 CLUSTER = ("import sys; from demfem.cartridge import Cartridge; from demfem.materials import "
            "Material; from demfem.scenes import CartridgeCluster; "
-           "from demfem.studies.cluster_run import run_cluster; "
+           "from demfem.fem.cluster_run import run_cluster; "
            "tube = Cartridge.tube(11.6e-3, 1.1e-3, 10e-3, material=Material(1e8, 0.22, 2230.0)); "
            "c = CartridgeCluster.load_case('max', layers=1, cartridge=tube, springs=True); "
            "run_cluster(c, duration=3e-3, out=sys.argv[1], progress=False, n_snapshots=4, "

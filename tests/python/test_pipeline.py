@@ -17,7 +17,7 @@ from demfem.errors import InvalidParameterError, SimulationInterrupted
 from demfem.jobs import sha256_file
 from demfem.pipeline import NEXT_STEPS, run_pipeline
 from demfem.scenes.table import AccumulationTable, Tag
-from demfem.studies.table_run import TableRun
+from demfem.dem.table_run import TableRun
 
 
 @pytest.fixture(scope="module")

@@ -17,7 +17,7 @@ from scipy import integrate, stats
 from demfem.errors import InvalidParameterError
 from demfem.risk.interval import (METHODS, block_totals, hourly_interval_from_events,
                                   interval_from_blocks, rate_interval)
-from demfem.studies.steady import period_rates, relative_error
+from demfem.dem.steady import period_rates, relative_error
 
 PERIOD = 2.0
 

@@ -93,7 +93,7 @@ def test_cluster_from_a_dem_run_takes_its_cartridge_and_load_case(tmp_path):
     """``demfem cluster --from RUN``: the load case from the run's onsets
     (CartridgeCluster.from_collisions) with the run's cartridge and friction."""
     from demfem.scenes.cluster import CartridgeCluster, cluster_from_run
-    from demfem.studies.table_run import run_table
+    from demfem.dem.table_run import run_table
 
     t = AccumulationTable(**SMALL, cartridge=Cartridge(**THIN), friction=0.3)
     run = run_table(t, 0.3, 0.01)

@@ -8,8 +8,8 @@ from demfem.assess.risk_stage import steady_state
 from demfem.assess.run import steady_rule
 from demfem.errors import InvalidParameterError
 from demfem.scenes import AccumulationTable
-from demfem.studies import run_table
-from demfem.studies.steady import SteadyRule, period_rates, relative_error
+from demfem.dem.table_run import run_table
+from demfem.dem.steady import SteadyRule, period_rates, relative_error
 
 TINY = dict(width=0.1, length=0.1, tilted_wall_length=0.08, opening_width=0.03,
             gate_amplitude=0.01, gate_period=0.2, belt_velocity=0.5, young_modulus=1e7,

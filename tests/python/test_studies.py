@@ -8,7 +8,7 @@ import pytest
 from demfem.cli import main
 from demfem.errors import InvalidParameterError
 from demfem.scenes import AccumulationTable, Tag
-from demfem.studies import TableRun, run_table, sweep_point, table_from_params
+from demfem.dem.table_run import TableRun, run_table, sweep_point, table_from_params
 from demfem.studies import figures
 from demfem.sweep import run_key
 

@@ -1,6 +1,6 @@
 """Impact events from a DEM run: one row per contact onset hard enough to matter.
 
-What the record holds: :func:`demfem.studies.table_run.run_table` logs every contact onset,
+What the record holds: :func:`demfem.dem.table_run.run_table` logs every contact onset,
 sphere–sphere (partners i and j) and sphere–wall (the wall's index and the contact point), with
 the time and the normal and tangential relative speed at onset (against a moving wall, the gate,
 relative to its surface). Sphere–sphere events are partner type ``"sphere"``; impacts on the
@@ -87,7 +87,7 @@ def _centres_at(run, t: np.ndarray, idx: np.ndarray) -> np.ndarray:
 
 def impact_events(run, min_speed: float = DEFAULT_MIN_SPEED,
                   min_force: float = math.inf) -> tuple[np.ndarray, dict[str, Any]]:
-    """The impact events of a :class:`~demfem.studies.table_run.TableRun` with a normal
+    """The impact events of a :class:`~demfem.dem.table_run.TableRun` with a normal
     speed ≥ ``min_speed`` (m/s, ≥ 0) or, for measured contacts, a peak normal force ≥
     ``min_force`` (N, ≥ 0; default: no such rescue), sphere–sphere and sphere–wall (not the
     belt), in time order, as an array of :data:`EVENT_DTYPE`; and a summary: ``n_onsets``

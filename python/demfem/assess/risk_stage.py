@@ -186,7 +186,7 @@ def steady_state(events: np.ndarray, p_event: np.ndarray, window: tuple[float, f
     ``steady``: with periods, the events' relative standard error at most ``tolerance`` (the
     rate swings within a gate period and wanders over several, so only whole periods count
     and only their scatter measures the uncertainty); without, |z| < 2."""
-    from demfem.studies.steady import period_rates, relative_error
+    from demfem.dem.steady import period_rates, relative_error
 
     t0, t1 = window
     mid = 0.5 * (t0 + t1)

@@ -3,7 +3,7 @@ per cartridge, in six resumable stages (:data:`demfem.assess.stages.STAGES`):
 
 1. **calibration** — the cartridge's equivalent body, its Hertz–Reissner law and the stress
    model in use (``calibration.json``);
-2. **dem** — the table run (:func:`demfem.studies.table_run.run_table`, ``table_run.npz``;
+2. **dem** — the table run (:func:`demfem.dem.table_run.run_table`, ``table_run.npz``;
    checkpoints into ``table.ck`` and resumes mid-run);
 3. **events** — impact events above the minimum speed (``events.npz``);
 4. **stress** — force, duration, σ1 and stressed area per event (``stress.npz``);
@@ -58,12 +58,12 @@ def duration_help() -> str:
 
 
 def steady_rule(table, full: bool = False, min_speed: float = DEFAULT_MIN_SPEED):
-    """The :class:`demfem.studies.steady.SteadyRule` of an assessment of ``table``: periods
+    """The :class:`demfem.dem.steady.SteadyRule` of an assessment of ``table``: periods
     of the gate (1 s for a still gate) counted from a 2 s warm-up, at least 4 of them and the
     relative standard error of their mean impacts at most 10 % (``full``: 8 and 5 %),
     impacts as the events stage counts them (not the belt)."""
     from demfem.assess.events import NOT_IMPACTS
-    from demfem.studies.steady import SteadyRule
+    from demfem.dem.steady import SteadyRule
 
     names = [str(w["name"]) for w in table.build().walls]
     return SteadyRule(period=float(table.gate_period) if table.gate_amplitude > 0 else 1.0,
@@ -244,7 +244,7 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
     from demfem.pipeline import load_scene
     from demfem.risk import INNER_SURFACE, OUTER_SURFACE, SCG_BOROSILICATE
     from demfem.risk.strength_file import load_strength_file
-    from demfem.studies.table_run import check_run_arguments
+    from demfem.dem.table_run import check_run_arguments
 
     # every argument checked before any work
     if quick and full:
@@ -381,7 +381,7 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
             return {"stopped_after": "calibration"}
 
         # 2. DEM
-        from demfem.studies.table_run import TableRun, run_table
+        from demfem.dem.table_run import TableRun, run_table
 
         run_path = out / "table_run.npz"
         done = book.is_done("dem")

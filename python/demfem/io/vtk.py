@@ -173,7 +173,7 @@ def write_vtk_series(folder: str | Path, run: Any, interval: float,
     (m/s), ``force`` (N) and ``coordination``) and ``<name>.pvd`` listing them; returns the
     ``.pvd`` path.
 
-    ``run`` is a :class:`demfem.studies.TableRun` (or any object with its ``times``,
+    ``run`` is a :class:`demfem.dem.table_run.TableRun` (or any object with its ``times``,
     ``positions``, ``velocities``, ``forces``, ``coordination``, ``present``, ``radii`` and
     ``tags`` arrays). Frames of an earlier series of the same ``name`` in ``folder`` are
     removed first, so the folder never mixes two runs.

@@ -237,7 +237,7 @@ class CartridgeCluster:
         hand).
 
         ``onsets``: a table of :data:`demfem.analysis.collisions.ONSET_DTYPE` (e.g.
-        ``TableRunRecord.onsets`` of :func:`demfem.studies.table_run.run_table`). A sphere
+        ``TableRunRecord.onsets`` of :func:`demfem.dem.table_run.run_table`). A sphere
         hit twice by different partners with onsets at most ``window`` s apart is a
         candidate; its stronger impact (normal speed) becomes cartridge 2, the weaker 3.
 
@@ -537,10 +537,10 @@ def _impact_pairs(table: np.ndarray, window: float) -> list:
 def cluster_from_run(run: Any, which: str = "max", **overrides: Any) -> CartridgeCluster:
     """The cluster whose load case comes from a DEM table run
     (:meth:`CartridgeCluster.from_collisions` on its onsets), with the run's cartridge, glass
-    and friction. ``run``: a :class:`demfem.studies.table_run.TableRun`, a ``table_run.npz``
+    and friction. ``run``: a :class:`demfem.dem.table_run.TableRun`, a ``table_run.npz``
     or the folder of a ``demfem run`` / ``demfem assess`` that holds one."""
     from demfem.errors import DemfemIOError
-    from demfem.studies.table_run import TableRun
+    from demfem.dem.table_run import TableRun
 
     if not isinstance(run, TableRun):
         path = Path(run)

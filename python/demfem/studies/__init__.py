@@ -1,5 +1,3 @@
-"""The paper's DEM studies (Figs. 5-9): recorded table runs, a sweep runner and one function
-per figure. See :mod:`demfem.studies.table_run` and :mod:`demfem.studies.figures`."""
-from demfem.studies.table_run import RUN_OPTIONS, TableRun, run_table, sweep_point, table_from_params
-
-__all__ = ["RUN_OPTIONS", "TableRun", "run_table", "sweep_point", "table_from_params"]
+"""The paper's DEM studies (Figs. 5-9): one function per figure that runs its table runs
+(:func:`demfem.dem.table_run.sweep_point` through :func:`demfem.sweep.sweep`), analyses and
+plots them. See :mod:`demfem.studies.figures`."""

@@ -1,7 +1,7 @@
 """The paper's DEM studies (Boso et al. 2021, Figs. 5-9) as functions that run, analyse and plot.
 
 Every study runs its table runs through :func:`demfem.sweep.sweep` (a Dask LocalCluster by
-default, one run per worker, ``threads=1`` per run) with :func:`demfem.studies.sweep_point` as
+default, one run per worker, ``threads=1`` per run) with :func:`demfem.dem.table_run.sweep_point` as
 the runner, into one shared folder ``<out>/runs``: a run asked for by two studies (same
 parameters, E and duration) is made once and a re-launched study only runs what is missing.
 
@@ -37,7 +37,7 @@ from demfem.errors import InvalidParameterError  # noqa: E402
 from demfem.io import (json_dumps, savefig_atomic, write_json_atomic,  # noqa: E402
                        write_text_atomic, write_vtk_series)
 from demfem.scenes.table import Tag  # noqa: E402
-from demfem.studies.table_run import TableRun, table_from_params  # noqa: E402
+from demfem.dem.table_run import TableRun, table_from_params  # noqa: E402
 
 __all__ = [
     "StudyOptions",
@@ -116,7 +116,7 @@ def _sweep_runs(opts: StudyOptions, grid: dict[str, list[Any]], duration: float,
     def progress(done: int, total: int) -> None:
         opts.log(f"  {label}: runs finished {done}/{total}")
 
-    result = sweep(grid, "demfem.studies.table_run:sweep_point", opts.out,
+    result = sweep(grid, "demfem.dem.table_run:sweep_point", opts.out,
                    scheduler=opts.scheduler, n_workers=opts.workers, fixed=fixed,
                    progress=progress)
     return [(r["params"], TableRun.load(r["result"]["run_file"])) for r in result.records]

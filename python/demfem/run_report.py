@@ -25,7 +25,7 @@ _ANGLE_LABEL = "impact angle atan2(v_t, v_n) (deg; 0 = head-on, 90 = grazing)"
 
 def write_analysis(out: Path, run: Any, table: Any, duration: float, discard: float,
                    sample_interval: float, log: Callable[[str], None]) -> dict[str, Any]:
-    """Analyse ``run`` (a :class:`~demfem.studies.TableRun` of ``table``) from ``discard``
+    """Analyse ``run`` (a :class:`~demfem.dem.table_run.TableRun` of ``table``) from ``discard``
     (s) on, log the numbers and write the files; returns the ``table`` and ``collisions``
     sections of the summary and the ``files`` written."""
     from demfem.analysis.collisions import onset_quantiles

@@ -1,7 +1,7 @@
 """What a table run records as it goes: samples of the state at fixed times, every contact
 onset (sphere–sphere and sphere–wall), the whole-contact events when asked for, and the
 removals; saved to and restored from a partial record for a checkpoint
-(:func:`demfem.studies.table_run.run_table`).
+(:func:`demfem.dem.table_run.run_table`).
 
 SI units: s, m, m/s, N, N s.
 """
@@ -19,7 +19,7 @@ from demfem.scenes.table import AccumulationTable
 
 __all__ = ["Recorder", "ARRAYS", "event_columns", "kept_events"]
 
-#: The sampled arrays of a run (see :class:`demfem.studies.table_run.TableRun`).
+#: The sampled arrays of a run (see :class:`demfem.dem.table_run.TableRun`).
 ARRAYS = ("times", "positions", "velocities", "coordination", "forces", "opening",
           "riding_up", "max_overlap", "kinetic_energy")
 
@@ -111,7 +111,7 @@ class Recorder:
 
     def impact_times(self, rule) -> np.ndarray:
         """Times (s) of the recorded onsets that ``rule`` (a
-        :class:`demfem.studies.steady.SteadyRule`) counts as impacts."""
+        :class:`demfem.dem.steady.SteadyRule`) counts as impacts."""
         sphere, wall = self.raw_onsets(), self.raw_onsets(walls=True)
         both = {"time": np.concatenate([sphere["time"], wall["time"]]),
                 "normal_speed": np.concatenate([sphere["normal_speed"], wall["normal_speed"]]),

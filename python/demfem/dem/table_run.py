@@ -40,8 +40,8 @@ from demfem.io.strict_json import dumps as json_dumps
 from demfem.jobs.folder import settings_differences, sha256_file
 from demfem.progress import ProgressBar
 from demfem.scenes.table import AccumulationTable
-from demfem.studies.steady import SteadyRule
-from demfem.studies.table_record import ARRAYS, Recorder, event_columns, kept_events
+from demfem.dem.steady import SteadyRule
+from demfem.dem.table_record import ARRAYS, Recorder, event_columns, kept_events
 
 __all__ = ["TableRun", "run_table", "sweep_point", "table_from_params", "RUN_OPTIONS",
            "check_run_arguments", "checkpoint_files", "checkpoint_state", "run_settings",
@@ -320,7 +320,7 @@ def run_table(table: AccumulationTable, duration: float, sample_interval: float 
             every contact's normal force on every step (about 1.3x the step's time on the
             default table, ``benches/dem_events_cost.py``).
         steady: stop before ``duration`` (then the longest run) once the collision rate is
-            steady by this :class:`demfem.studies.steady.SteadyRule`, checked at every whole
+            steady by this :class:`demfem.dem.steady.SteadyRule`, checked at every whole
             period; ``info["steady"]`` holds the last check and ``info["duration"]`` the time
             the run ended.
         keep_events: (min_speed m/s, min_force N): keep only the contact events that began

@@ -12,6 +12,12 @@ Example::
     sim = dem.DemSimulation(positions, radii, [glass], [belt],
                             ["gravity", "belt", "friction", "rotation", "damping"])
     dem.run(sim, 1.0, progress=print)
+
+The recorded runs of the accumulation table live in the submodules (imported on their own,
+not by this package): :mod:`demfem.dem.table_run` (:func:`~demfem.dem.table_run.run_table`,
+:class:`~demfem.dem.table_run.TableRun`, checkpoints, the sweep runner),
+:mod:`demfem.dem.table_record` (what a run records as it goes) and :mod:`demfem.dem.steady`
+(the rule that stops a run once its collision rate is steady).
 """
 from __future__ import annotations
 
@@ -228,7 +234,7 @@ def from_scene(
     tangential force (N), normal impulse (N s) and largest overlap (m), measured step by step
     (``sim.events()``, ``sim.open_events()``); off, it costs nothing.
     A scene that re-feeds removed spheres (``scene.refeed``) is run with
-    ``run(sim, t, refeed=scene.refeed)`` or :func:`demfem.studies.run_table`.
+    ``run(sim, t, refeed=scene.refeed)`` or :func:`demfem.dem.table_run.run_table`.
     """
     import numpy as np
 
