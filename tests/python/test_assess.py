@@ -498,3 +498,11 @@ def test_contact_stress_stage_matches_demfem_stress_per_partner():
                              measured_impulse=np.array([45e-4]))
     assert old["sigma_inner_Pa"][0] == pytest.approx(
         StressModel.default().sigma_inner(np.array([45.0]))[0])
+
+
+def test_the_job_goes_through_its_stages_in_order_and_names_their_files():
+    from demfem.assess.job_stages import JOB_STAGES
+    from demfem.assess.run import OUTPUT_FILES
+
+    assert tuple(stage.name for stage in JOB_STAGES) == STAGES
+    assert {f for stage in JOB_STAGES for f in stage.files} == {*OUTPUT_FILES, *FIGURES}

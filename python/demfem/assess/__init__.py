@@ -10,8 +10,9 @@ per cartridge (calibration → DEM → collision events → stress model → Wei
 * :mod:`~demfem.assess.risk_stage` — probabilities per event, cartridge and hour, steady
   state, worst collisions, risk map;
 * :mod:`~demfem.assess.stages`, :mod:`~demfem.assess.run` — the resumable job
-  (:func:`assess`), :mod:`~demfem.assess.report` and :mod:`~demfem.assess.figures` — the
-  HTML report.
+  (:func:`assess`), its stages (:mod:`~demfem.assess.job_stages`, each a
+  :class:`~demfem.assess.job.Stage`), :mod:`~demfem.assess.report` and
+  :mod:`~demfem.assess.figures` — the HTML report.
 
 See ``docs/assess.md``. SI units throughout.
 """

@@ -1,0 +1,136 @@
+"""What one stage of ``demfem assess`` is (:class:`Stage`) and what it works on
+(:class:`JobContext`): the job's checked settings and what the earlier stages produced.
+
+A stage has a name (one of :data:`demfem.assess.stages.STAGES`), a title for its console
+header, the files it writes, :meth:`Stage.run` (compute, write the files, return them with
+what it computed) and :meth:`Stage.load` (read its files back, for a stage completed
+before). :func:`demfem.assess.run.assess` goes through the stages in order on one
+:class:`~demfem.assess.stages.StageBook`; the stages themselves are in
+:mod:`demfem.assess.job_stages`.
+
+SI units throughout: m, s, kg, N, Pa.
+"""
+from __future__ import annotations
+
+import abc
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Callable, Optional
+
+if TYPE_CHECKING:
+    from demfem.dem.steady import SteadyRule
+    from demfem.risk.fatigue import SlowCrackGrowth
+    from demfem.scenes.table import AccumulationTable
+    from demfem.stress.stress_model import StressModel
+
+__all__ = ["JobContext", "Stage", "StageOutput"]
+
+
+@dataclass
+class JobContext:
+    """The settings of one assessment, checked, and what its stages produced so far.
+
+    Attributes:
+        table: the table (:class:`demfem.scenes.table.AccumulationTable`), re-fed if asked.
+        settings: the job's settings as recorded in ``stages.json``.
+        out: the output folder.
+        log: where the console lines go.
+        duration: simulated time of the table, s (the longest, when run until steady).
+        sample_interval: time between recorded samples, s.
+        rule: the steady rule (:class:`demfem.dem.steady.SteadyRule`) of a run until steady;
+            None for a fixed duration.
+        discard_before: start of the statistics window of a fixed-duration run, s.
+        min_speed: minimum normal impact speed of an event, m/s.
+        throughput: cartridges per hour of the user's line; None: the table's own discharge.
+        model: the stress model (``"contact"``, ``"shell"`` or a
+            :class:`demfem.stress.stress_model.StressModel`).
+        pair_geometry: the contact of two cartridges (``"crossed"`` or ``"parallel"``).
+        stress_young_modulus: Young's modulus of the stresses, Pa.
+        slow_crack_growth: the slow-crack-growth law (:data:`demfem.risk.SCG_BOROSILICATE`)
+            or None.
+        surfaces: ``inner`` and ``outer`` surface strengths (:class:`demfem.risk`
+            surfaces), their ``source`` in words and the ``measured`` ones.
+        flaw_depth: depth of the outer surface's flaws, m; None: the surface value.
+        csv: also write the tables as CSV.
+        threads: DEM threads.
+        checkpoint_every: wall time between DEM checkpoints, s.
+        fresh: the job replaces an earlier one in ``out``.
+        progress: a progress bar on standard error for the DEM stage.
+        seed: the perturbed start's seed, or None for the scene's own start.
+        produced: what each completed stage produced, by stage name (see each stage).
+    """
+
+    table: AccumulationTable
+    settings: dict[str, Any]
+    out: Path
+    log: Callable[[str], None]
+    duration: float
+    sample_interval: float
+    rule: Optional[SteadyRule]
+    discard_before: float
+    min_speed: float
+    throughput: Optional[float]
+    model: str | StressModel
+    pair_geometry: str
+    stress_young_modulus: float
+    slow_crack_growth: Optional[SlowCrackGrowth]
+    surfaces: dict[str, Any]
+    flaw_depth: Optional[float]
+    csv: bool
+    threads: int
+    checkpoint_every: float
+    fresh: bool
+    progress: bool
+    seed: Optional[int]
+    produced: dict[str, Any] = field(default_factory=dict)
+
+    def window(self) -> tuple[float, float]:
+        """The statistics window (start, end), s, once the DEM stage has run: every whole
+        gate period since the warm-up for a run until steady, else from ``discard_before``;
+        the end is where the table run stopped."""
+        end = float(self.produced["dem"].info["duration"])
+        start = min(self.rule.warmup, end) if self.rule is not None else self.discard_before
+        return start, end
+
+
+@dataclass
+class StageOutput:
+    """What :meth:`Stage.run` returns: the ``files`` it wrote (recorded with their SHA-256)
+    and the ``product`` it computed, or None when later stages read it back from the files
+    (:meth:`Stage.load`)."""
+
+    files: list[Path]
+    product: Any = None
+
+
+class Stage(abc.ABC):
+    """One resumable stage of ``demfem assess`` (module docstring)."""
+
+    #: The stage's name, one of :data:`demfem.assess.stages.STAGES`.
+    name: str = ""
+    #: The files it writes, relative to the output folder (glob patterns).
+    files: tuple[str, ...] = ()
+
+    @abc.abstractmethod
+    def title(self, ctx: JobContext) -> str:
+        """What the stage does, for its console header."""
+
+    def begin(self, ctx: JobContext) -> None:
+        """Log what holds whether the stage runs or is reused (after its header, before it
+        runs); by default nothing."""
+
+    @abc.abstractmethod
+    def run(self, ctx: JobContext) -> StageOutput:
+        """Compute the stage from ``ctx`` and write its files."""
+
+    @abc.abstractmethod
+    def load(self, ctx: JobContext) -> Any:
+        """The stage's product, read back from its files."""
+
+    def show(self, ctx: JobContext) -> None:
+        """Log the stage's result (its product is ``ctx.produced[self.name]``); by default
+        nothing."""
+
+    def answer(self, ctx: JobContext) -> dict[str, Any]:
+        """What :func:`demfem.assess.assess` returns when it ends after this stage."""
+        return {"stopped_after": self.name}
