@@ -1,14 +1,23 @@
 """demfem's speed as a ratio to Yade and LIGGGHTS on the anchor table, measured in one run.
 
-The anchor scripts in ``shared/anchors/dem`` (``run_liggghts.py``, ``yade_bench.py``) run the
-identical scene (840 glass spheres of 16 mm, E = 45 GPa, Hertz–Mindlin, μ 0.2, e 0.5, belt
+The anchor scripts (``run_liggghts.py``, ``yade_bench.py``, ``bench_all.py``, ``scene.py``) run
+the identical scene (840 glass spheres of 16 mm, E = 45 GPa, Hertz–Mindlin, μ 0.2, e 0.5, belt
 0.2 m/s, funnel, dt = 0.5 r √(ρ/E)); this script runs them and demfem back to back, from the
 ``start`` state (square packing, ``--settle`` untimed steps, then ``--steps`` timed steps), and
 prints particle-steps per second and demfem's ratio to each. Because the codes run in the same
 session, the ratio is robust to the load of a shared machine; the absolute numbers are not.
+demfem's side is the same scene built by a benchmark fixture of the engine
+(``DemSimulation._anchor_table``), not a public API.
+
+**Where the anchors are.** They are not in this repository: they are the project's shared
+anchor folder ``shared/anchors/dem``, delivered beside the repository (``../shared/anchors/dem``
+from the repository root, the default of ``--anchors``). Point ``--anchors DIR`` at another
+copy; ``--state packed`` needs a writable copy, in which the anchors' packed states are made
+once (≈ 40 min) by ``python3 bench_all.py prepare --E 45e9``.
 
     python benches/dem_anchor_ratio.py --steps 20000 --settle 2000 [--threads 1 2] [--skip-yade]
-    python benches/dem_anchor_ratio.py --state packed --steps 20000 --reps 3   # after bench_all.py prepare
+    python benches/dem_anchor_ratio.py --anchors COPY --state packed --steps 20000 --reps 5 \
+        --threads 1 2 --json docs/data/dem_anchor_ratio_packed.json
 
 Needs the Debian packages yade and liggghts for the anchors, and demfem built
 (``maturin develop --release``).
@@ -32,7 +41,25 @@ TARGET_RATE = {1: 1.5e7, 2: 2.5e7}
 TARGET_RATIO = {"yade": 15.0, "liggghts": 3.0}
 REFERENCE_RATE = {"yade": 1.0e6, "liggghts": 4.4e6}
 
-ANCHORS = os.environ.get("DEMFEM_ANCHORS", os.path.join(os.path.dirname(__file__), "..", "..", "shared", "anchors", "dem"))
+#: The default anchor folder: ``shared/anchors/dem`` beside the repository (not in it).
+DEFAULT_ANCHORS = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..",
+                                                "shared", "anchors", "dem"))
+#: What the script runs from the anchor folder.
+ANCHOR_FILES = ("run_liggghts.py", "yade_bench.py", "bench_all.py", "scene.py")
+
+
+def check_anchors(anchors: str) -> str:
+    """The anchor folder as an absolute path; exits with a message naming the path and how to
+    get the anchors when it or one of :data:`ANCHOR_FILES` is missing."""
+    anchors = os.path.abspath(anchors)
+    missing = [f for f in ANCHOR_FILES if not os.path.isfile(os.path.join(anchors, f))]
+    if missing:
+        where = "does not exist" if not os.path.isdir(anchors) else f"lacks {', '.join(missing)}"
+        sys.exit(f"dem_anchor_ratio: the anchor folder {anchors} {where}. The Yade and LIGGGHTS "
+                 f"anchor scripts ({', '.join(ANCHOR_FILES)}) are not in this repository: they are "
+                 f"the project's shared folder shared/anchors/dem, expected beside the repository "
+                 f"at {DEFAULT_ANCHORS}. Copy it there or pass --anchors DIR.")
+    return anchors
 
 
 def run_anchor(cmd: list[str], cwd: str) -> dict:
@@ -62,7 +89,7 @@ def demfem_packed_state(e: float, anchors: str, cache: str) -> str:
     if not os.path.exists(path):
         n = int(anchors_module(anchors).prep_steps(e))
         print(f"preparing demfem's packed state: {n} steps (cached in {path})", flush=True)
-        sim = DemSimulation.anchor_table(e, start="square", threads=2, initial_vx=0.2)
+        sim = DemSimulation._anchor_table(e, start="square", threads=2, initial_vx=0.2)
         sim.step(n)
         os.makedirs(cache, exist_ok=True)
         sim.save_checkpoint(path)
@@ -72,7 +99,7 @@ def demfem_packed_state(e: float, anchors: str, cache: str) -> str:
 def run_demfem(e: float, steps: int, settle: int, threads: int, start: str, load: str | None = None) -> dict:
     from demfem.dem import DemSimulation
 
-    sim = DemSimulation.anchor_table(e, start=start, threads=threads, initial_vx=0.2 if load else 0.0)
+    sim = DemSimulation._anchor_table(e, start=start, threads=threads, initial_vx=0.2 if load else 0.0)
     if load:
         sim.load_checkpoint(load)
     else:
@@ -127,6 +154,9 @@ def target_report(per_rep: dict[str, list[float]], demfem_rate: dict[int, float]
 
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--anchors", default=DEFAULT_ANCHORS,
+                   help="the anchor folder (shared/anchors/dem: run_liggghts.py, yade_bench.py, "
+                        "bench_all.py, scene.py); default: beside the repository, %(default)s")
     p.add_argument("--E", type=float, default=45e9)
     p.add_argument("--steps", type=int, default=20000)
     p.add_argument("--settle", type=int, default=2000)
@@ -141,7 +171,7 @@ def main() -> None:
     p.add_argument("--cache", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), ".states"),
                    help="where demfem's packed state is cached")
     a = p.parse_args()
-    anchors = os.path.abspath(ANCHORS)
+    anchors = check_anchors(a.anchors)
     packed = a.state == "packed"
     if packed:
         bench_all = anchors_module(anchors)

@@ -113,7 +113,7 @@ class DemSimulation:
     def removals(self) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint32]]:
         """Particles removed through the outlet plane: times (s) and indices."""
     @staticmethod
-    def anchor_table(
+    def _anchor_table(
         young_modulus: float = 45e9,
         start: str = "square",
         threads: int = 1,
@@ -121,8 +121,11 @@ class DemSimulation:
         record_every: int = 0,
         record_onsets: bool = False,
     ) -> DemSimulation:
-        """The anchor table of shared/anchors/dem/scene.py at E (Pa); start 'square' or
-        'packed'; initial_vx (m/s) for every sphere."""
+        """Benchmark fixture, not part of the API: the anchor table of
+        shared/anchors/dem/scene.py (the scene Yade and LIGGGHTS run in
+        benches/dem_anchor_ratio.py) at E (Pa); start 'square' or 'packed'; initial_vx (m/s)
+        for every sphere. Tables for use: demfem.scenes.AccumulationTable and
+        demfem.dem.from_scene."""
     def step(self, n: int, chunk: int = 2000) -> None:
         """Advance n steps; the GIL is released in slices of about 0.1 s of wall time
         whatever ``chunk`` is, so Ctrl-C raises SimulationInterrupted within a fraction of a

@@ -42,3 +42,18 @@ def test_json_is_written_whole_or_not_at_all(bench, tmp_path):
                                                     "particle_steps_per_s": 1.0}]))
     assert json.loads(path.read_text()) == [{"code": "demfem", "particle_steps_per_s": 1.0}]
     assert [p.name for p in tmp_path.iterdir()] == ["runs.json"]
+
+
+def test_a_missing_anchor_folder_is_named_with_where_to_get_it(bench, tmp_path):
+    # the anchors are not in the repository: the error names the folder looked in and the
+    # default place beside the repository, instead of a traceback from a bare path
+    with pytest.raises(SystemExit) as e:
+        bench.check_anchors(str(tmp_path / "nowhere"))
+    msg = str(e.value)
+    assert str(tmp_path / "nowhere") in msg and "does not exist" in msg
+    assert "shared/anchors/dem" in msg and "--anchors" in msg
+    (tmp_path / "partial").mkdir()
+    (tmp_path / "partial" / "scene.py").write_text("")
+    with pytest.raises(SystemExit, match="lacks run_liggghts.py, yade_bench.py, bench_all.py"):
+        bench.check_anchors(str(tmp_path / "partial"))
+    assert bench.DEFAULT_ANCHORS.endswith("shared/anchors/dem")

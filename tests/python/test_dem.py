@@ -63,7 +63,7 @@ def test_checkpoint_restart_is_bitwise_identical(tmp_path):
 
 
 def test_anchor_table_runs_and_reports_state():
-    sim = dem.DemSimulation.anchor_table(1e8, start="packed", threads=2)
+    sim = dem.DemSimulation._anchor_table(1e8, start="packed", threads=2)
     assert len(sim) == 840 and sim.dt == pytest.approx(0.5 * R * (2230.0 / 1e8) ** 0.5)
     sim.step(3000)  # the belt closes the 0.1 % gaps of the packing within ~40 ms
     assert sim.positions().shape == (840, 3) and np.isfinite(sim.positions()).all()
@@ -72,8 +72,8 @@ def test_anchor_table_runs_and_reports_state():
 
 
 def test_phase_clock_reads_each_threads_blocks_and_changes_nothing():
-    a = dem.DemSimulation.anchor_table(1e8, start="packed", threads=2)
-    b = dem.DemSimulation.anchor_table(1e8, start="packed", threads=2)
+    a = dem.DemSimulation._anchor_table(1e8, start="packed", threads=2)
+    b = dem.DemSimulation._anchor_table(1e8, start="packed", threads=2)
     assert a.phase_times() == []
     a.set_phase_timing(True)
     a.step(500)
@@ -87,8 +87,8 @@ def test_phase_clock_reads_each_threads_blocks_and_changes_nothing():
 
 
 def test_block_cuts_name_where_each_threads_block_begins():
-    two = dem.DemSimulation.anchor_table(1e8, start="packed", threads=2)
-    one = dem.DemSimulation.anchor_table(1e8, start="packed", threads=1)
+    two = dem.DemSimulation._anchor_table(1e8, start="packed", threads=2)
+    one = dem.DemSimulation._anchor_table(1e8, start="packed", threads=1)
     assert one.block_cuts() == []
     two.step(400)
     one.step(400)
@@ -114,7 +114,7 @@ def test_ctrl_c_stops_cleanly_at_a_step_boundary():
 
     from demfem.errors import SimulationInterrupted
 
-    sim = dem.DemSimulation.anchor_table(1e8, start="square")
+    sim = dem.DemSimulation._anchor_table(1e8, start="square")
     timer = threading.Timer(0.3, _thread.interrupt_main)  # what Ctrl-C does
     timer.start()
     with pytest.raises(SimulationInterrupted):

@@ -104,7 +104,7 @@ def test_ctrl_c_is_seen_within_a_second_even_with_one_huge_chunk():
     import _thread
     import threading
 
-    sim = dem.DemSimulation.anchor_table(1e8, start="square")
+    sim = dem.DemSimulation._anchor_table(1e8, start="square")
     timer = threading.Timer(0.3, _thread.interrupt_main)
     start = time.perf_counter()
     timer.start()
@@ -118,8 +118,8 @@ def test_ctrl_c_is_seen_within_a_second_even_with_one_huge_chunk():
 
 
 def test_slicing_a_chunk_does_not_change_the_result():
-    a = dem.DemSimulation.anchor_table(1e8, start="packed")
-    b = dem.DemSimulation.anchor_table(1e8, start="packed")
+    a = dem.DemSimulation._anchor_table(1e8, start="packed")
+    b = dem.DemSimulation._anchor_table(1e8, start="packed")
     a.step(600, chunk=600)
     for _ in range(200):
         b.step(3, chunk=1)

@@ -258,13 +258,15 @@ impl DemSimulation {
         Ok(DemSimulation { sim })
     }
 
-    /// The anchor accumulation table of `shared/anchors/dem/scene.py` (840 glass spheres of
-    /// 16 mm, belt 0.2 m/s, funnel with closed outlet, dt = 0.5 r √(ρ/E)) at Young's modulus
-    /// `young_modulus` (Pa). `start`: "square" (scene.py's 1 %-gap square packing at rest) or
-    /// "packed" (dense hexagonal packing against the funnel); `initial_vx` (m/s) sets every
-    /// sphere's x velocity.
+    /// Benchmark fixture, not part of the API: the anchor accumulation table of
+    /// `shared/anchors/dem/scene.py`, built exactly as Yade and LIGGGHTS build it for
+    /// `benches/dem_anchor_ratio.py` (840 glass spheres of 16 mm, belt 0.2 m/s, funnel with
+    /// closed outlet, dt = 0.5 r √(ρ/E)) at Young's modulus `young_modulus` (Pa). `start`:
+    /// "square" (scene.py's 1 %-gap square packing at rest) or "packed" (dense hexagonal
+    /// packing against the funnel); `initial_vx` (m/s) sets every sphere's x velocity. Users
+    /// build tables with `demfem.scenes.AccumulationTable` and `demfem.dem.from_scene`.
     #[staticmethod]
-    #[pyo3(signature = (young_modulus=45e9, start="square", threads=1, initial_vx=0.0, record_every=0, record_onsets=false))]
+    #[pyo3(name = "_anchor_table", signature = (young_modulus=45e9, start="square", threads=1, initial_vx=0.0, record_every=0, record_onsets=false))]
     fn anchor_table(
         py: Python<'_>,
         young_modulus: f64,
