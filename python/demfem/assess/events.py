@@ -226,6 +226,11 @@ def _summary(n_onsets: int, ev: np.ndarray, n_wall: int, per_wall: dict[str, int
 
 def _measured_events(run, v_min: float, f_min: float) -> tuple[np.ndarray, dict[str, Any]]:
     """:func:`impact_events` from the run's measured whole contacts."""
+    if run.info.get("kept_record") and not len(run.contact_events):
+        raise InvalidParameterError(
+            "invalid run: it is the record a finished assessment keeps "
+            "(demfem.assess.job_stages.kept_record), without its whole contacts; its events "
+            "are in the assessment's events.parquet (demfem.assess.load_assessment)")
     c = np.asarray(run.contact_events)
     names = [str(n) for n in run.info.get("wall_names", [])]
     wall = c["partner_is_wall"]

@@ -1,12 +1,26 @@
-"""What one stage of ``demfem assess`` is (:class:`Stage`) and what it works on
-(:class:`JobContext`): the job's checked settings and what the earlier stages produced.
+"""What one stage of ``demfem assess`` is (:class:`Stage`), what it works on
+(:class:`JobContext`: the job's checked settings and what the earlier stages produced) and
+the loop that goes through the stages (:func:`run_stages`).
 
 A stage has a name (one of :data:`demfem.assess.stages.STAGES`), a title for its console
 header, the files it writes, :meth:`Stage.run` (compute, write the files, return them with
 what it computed) and :meth:`Stage.load` (read its files back, for a stage completed
-before). :func:`demfem.assess.run.assess` goes through the stages in order on one
-:class:`~demfem.assess.stages.StageBook`; the stages themselves are in
-:mod:`demfem.assess.job_stages`.
+before). :func:`demfem.assess.run.assess` checks the job's arguments and hands the stages
+(:data:`demfem.assess.job_stages.JOB_STAGES`) to :func:`run_stages` with one
+:class:`~demfem.assess.stages.StageBook`.
+
+**What a finished folder keeps.** A stage's files are of two kinds: its products
+(:attr:`Stage.files`: what the user opens, and what a re-run of the finished folder reads
+back) and its intermediates (:attr:`Stage.intermediates`: what only the later stages read).
+While the job is unfinished both are kept, so that an interrupted job resumes at its first
+unfinished stage. Once the last stage has completed, :func:`run_stages` records each stage's
+digest (:meth:`Stage.digest`: the few numbers its console lines need, e.g. the event
+counts) in ``stages.json`` and removes the intermediates (:meth:`StageBook.finish
+<demfem.assess.stages.StageBook.finish>`): this is the only place that decides what a
+finished folder keeps. A re-run of the finished folder with the same settings reads each
+stage back from its products and digest (:meth:`Stage.recall`) and prints the same lines
+and returns the same document; a finished folder with a damaged or missing product reruns
+from the first stage whose intermediates are gone (the DEM).
 
 SI units throughout: m, s, kg, N, Pa.
 """
@@ -18,12 +32,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Optional
 
 if TYPE_CHECKING:
+    from demfem.assess.stages import StageBook
     from demfem.dem.steady import SteadyRule
     from demfem.risk.fatigue import SlowCrackGrowth
     from demfem.scenes.table import AccumulationTable
     from demfem.stress.stress_model import StressModel
 
-__all__ = ["JobContext", "Stage", "StageOutput"]
+__all__ = ["JobContext", "Stage", "StageOutput", "run_stages"]
 
 
 @dataclass
@@ -57,7 +72,10 @@ class JobContext:
         fresh: the job replaces an earlier one in ``out``.
         progress: a progress bar on standard error for the DEM stage.
         seed: the perturbed start's seed, or None for the scene's own start.
-        produced: what each completed stage produced, by stage name (see each stage).
+        produced: what each completed stage produced, by stage name (see each stage; None
+            for a stage of a finished folder whose intermediates are gone).
+        digests: each stage's digest (:meth:`Stage.digest`), by stage name: what its
+            console lines and the later stages' need of it.
     """
 
     table: AccumulationTable
@@ -83,6 +101,7 @@ class JobContext:
     progress: bool
     seed: Optional[int]
     produced: dict[str, Any] = field(default_factory=dict)
+    digests: dict[str, Any] = field(default_factory=dict)
 
     def window(self) -> tuple[float, float]:
         """The statistics window (start, end), s, once the DEM stage has run: every whole
@@ -108,8 +127,12 @@ class Stage(abc.ABC):
 
     #: The stage's name, one of :data:`demfem.assess.stages.STAGES`.
     name: str = ""
-    #: The files it writes, relative to the output folder (glob patterns).
+    #: The products it writes, kept in a finished folder, relative to the output folder
+    #: (glob patterns).
     files: tuple[str, ...] = ()
+    #: The files it writes for the later stages only, removed once the job has finished
+    #: (names relative to the output folder).
+    intermediates: tuple[str, ...] = ()
 
     @abc.abstractmethod
     def title(self, ctx: JobContext) -> str:
@@ -125,7 +148,20 @@ class Stage(abc.ABC):
 
     @abc.abstractmethod
     def load(self, ctx: JobContext) -> Any:
-        """The stage's product, read back from its files."""
+        """The stage's product, read back from its files (intermediates included)."""
+
+    def recall(self, ctx: JobContext) -> Any:
+        """The stage's product as a finished folder keeps it: read back from its products
+        alone (its intermediates are gone); by default :meth:`load`. Only :meth:`show`,
+        :meth:`answer` and the later stages' :meth:`begin` and :meth:`show` use it."""
+        return self.load(ctx)
+
+    def digest(self, ctx: JobContext) -> Optional[dict[str, Any]]:
+        """What the console lines (this stage's and the later stages') need of the stage's
+        product ``ctx.produced[self.name]``, as a small strict-JSON dict recorded in
+        ``stages.json`` when the job finishes, for a stage with intermediates; by default
+        None (nothing needed beyond :meth:`recall`)."""
+        return None
 
     def show(self, ctx: JobContext) -> None:
         """Log the stage's result (its product is ``ctx.produced[self.name]``); by default
@@ -134,3 +170,38 @@ class Stage(abc.ABC):
     def answer(self, ctx: JobContext) -> dict[str, Any]:
         """What :func:`demfem.assess.assess` returns when it ends after this stage."""
         return {"stopped_after": self.name}
+
+
+def run_stages(ctx: JobContext, stages: tuple[Stage, ...], book: StageBook,
+               stop_after: Optional[str] = None) -> dict[str, Any]:
+    """Go through ``stages`` in order on ``book`` (module docstring): a stage completed
+    before is read back (:meth:`Stage.load`, or :meth:`Stage.recall` in a finished folder),
+    any other runs and is recorded; the job ends after ``stop_after``. Once the last stage
+    has completed, the folder is finished: the stages' digests are recorded and their
+    intermediates removed. Returns the last stage's :meth:`Stage.answer`."""
+    log = ctx.log
+    stage = stages[0]
+    for k, stage in enumerate(stages, 1):
+        done = book.is_done(stage.name)
+        log(f"== {k}/{len(stages)} {stage.name}: {stage.title(ctx)}"
+            + (" (done before: reused) ==" if done else " =="))
+        stage.begin(ctx)
+        if done and book.finished:
+            ctx.produced[stage.name] = stage.recall(ctx)
+            ctx.digests[stage.name] = book.digest(stage.name)
+        else:
+            if done:
+                ctx.produced[stage.name] = stage.load(ctx)
+            else:
+                output = stage.run(ctx)
+                book.complete(stage.name, output.files)
+                ctx.produced[stage.name] = (stage.load(ctx) if output.product is None
+                                            else output.product)
+            ctx.digests[stage.name] = stage.digest(ctx)
+        stage.show(ctx)
+        if stage is stages[-1]:
+            book.finish({s.name: s.intermediates for s in stages},
+                        {name: d for name, d in ctx.digests.items() if d is not None})
+        if stage.name == stop_after:
+            break
+    return stage.answer(ctx)

@@ -3,17 +3,21 @@
 
 1. :class:`CalibrationStage` — the cartridge's equivalent body, its Hertz–Reissner law and
    the stress model in use (``calibration.json``; product: its content);
-2. :class:`DemStage` — the table run (:func:`demfem.dem.table_run.run_table`,
-   ``table_run.npz``; checkpoints into ``table.ck`` and resumes mid-run; product: the
-   :class:`~demfem.dem.table_run.TableRun`);
-3. :class:`EventsStage` — impact events above the minimum speed (``events.npz``; product:
-   the events and their counts);
-4. :class:`StressStage` — force, duration, σ1 and stressed area per event (``stress.npz``;
-   product: its arrays);
+2. :class:`DemStage` — the table run (:func:`demfem.dem.table_run.run_table`; checkpoints
+   into ``table.ck`` and resumes mid-run): ``table_run.npz``, the record a finished folder
+   keeps (:func:`kept_record`), and the intermediate ``table_run_full.npz``, the whole
+   record; product: the whole :class:`~demfem.dem.table_run.TableRun`;
+3. :class:`EventsStage` — impact events above the minimum speed (the intermediate
+   ``events.npz``; product: the events and their counts; digest: the counts);
+4. :class:`StressStage` — force, duration, σ1 and stressed area per event (the
+   intermediate ``stress.npz``; product: its arrays; digest: their largest values);
 5. :class:`RiskStage` — P per event, per cartridge and per hour, steady state, worst events,
-   risk map (``risk.json``, ``events.parquet``, ``passages.parquet``, ``risk_arrays.npz``;
-   product: ``risk.json``'s content);
+   risk map (``risk.json``, ``events.parquet``, ``passages.parquet``, ``events.vtp``,
+   ``cartridges.vtp``, ``risk_arrays.npz``; product: ``risk.json``'s content);
 6. :class:`ReportStage` — ``report.html`` and the figures.
+
+Each stage's ``files`` are its products, kept in a finished folder; its ``intermediates``
+are removed once the job has finished (:func:`demfem.assess.job.run_stages`).
 
 SI units throughout: m, s, kg, N, Pa.
 """
@@ -34,7 +38,35 @@ if TYPE_CHECKING:
     from demfem.dem.table_run import TableRun
 
 __all__ = ["JOB_STAGES", "CalibrationStage", "DemStage", "EventsStage", "StressStage",
-           "RiskStage", "ReportStage"]
+           "RiskStage", "ReportStage", "kept_record", "SINGLE_PRECISION_SAMPLES"]
+
+#: The DEM record's per-sphere samples that a finished folder keeps in single precision.
+SINGLE_PRECISION_SAMPLES = ("positions", "velocities", "forces", "coordination")
+
+
+def kept_record(run: TableRun) -> TableRun:
+    """The DEM record a finished assessment keeps (``table_run.npz``): ``run`` with its
+    per-sphere samples (:data:`SINGLE_PRECISION_SAMPLES`) in single precision (7 significant
+    digits; ≈ 17 MB instead of 48 MB on the default job) and without its whole contacts
+    (78 MB; the events made of them are in ``events.parquet``), marked so in
+    ``info["kept_record"]``. Every number of the job is computed from the whole record
+    (``table_run_full.npz``) before it is removed."""
+    import dataclasses
+
+    from demfem.analysis.contact_events import CONTACT_EVENT_DTYPE
+
+    single: dict[str, Any] = {k: np.asarray(getattr(run, k)).astype(np.float32)
+                              for k in SINGLE_PRECISION_SAMPLES}
+    return dataclasses.replace(
+        run, **single, contact_events=np.zeros(0, CONTACT_EVENT_DTYPE),
+        info={**run.info, "kept_record": {
+            "samples_in_single_precision": list(SINGLE_PRECISION_SAMPLES),
+            "contact_events": "not kept (the assessment's events are in events.parquet)"}})
+
+
+def _num(value: Any) -> float:
+    """A digest's number (strict JSON writes NaN as null)."""
+    return math.nan if value is None else float(value)
 
 
 def _model_words(model: Any, pair_geometry: str) -> str:
@@ -185,11 +217,14 @@ class CalibrationStage(Stage):
 
 class DemStage(Stage):
     """The table run, until steady or for a fixed time, with its onsets reduced to their
-    digest (:func:`demfem.assess.events.without_onsets`); product: the
+    digest (:func:`demfem.assess.events.without_onsets`): the whole record
+    (``table_run_full.npz``, an intermediate) and the one a finished folder keeps
+    (``table_run.npz``, :func:`kept_record`); product: the whole
     :class:`~demfem.dem.table_run.TableRun` (the one in memory when it has just run)."""
 
     name = "dem"
     files = ("table_run.npz",)
+    intermediates = ("table_run_full.npz",)
 
     def title(self, ctx: JobContext) -> str:
         table = ctx.table
@@ -217,11 +252,18 @@ class DemStage(Stage):
             if bar is not None:
                 bar.close()
         run = without_onsets(run, ctx.min_speed)  # their counts and speeds, not ~250 MB of onsets
-        path = ctx.out / "table_run.npz"
-        run.save(path)
-        return StageOutput([path], run)
+        full = run.save(ctx.out / "table_run_full.npz")
+        kept = kept_record(run).save(ctx.out / "table_run.npz")
+        return StageOutput([kept, full], run)
 
     def load(self, ctx: JobContext) -> TableRun:
+        from demfem.dem.table_run import TableRun
+
+        full = ctx.out / "table_run_full.npz"
+        # a folder of an earlier version holds the whole record as table_run.npz
+        return TableRun.load(full if full.is_file() else ctx.out / "table_run.npz")
+
+    def recall(self, ctx: JobContext) -> TableRun:
         from demfem.dem.table_run import TableRun
 
         return TableRun.load(ctx.out / "table_run.npz")
@@ -247,7 +289,7 @@ class EventsStage(Stage):
     product: (events, their counts)."""
 
     name = "events"
-    files = ("events.npz",)
+    intermediates = ("events.npz",)
 
     def title(self, ctx: JobContext) -> str:
         return f"impact events (normal speed >= {ctx.min_speed:g} m/s)"
@@ -268,10 +310,17 @@ class EventsStage(Stage):
         data = load_npz(ctx.out / "events.npz")
         return data["events"].astype(EVENT_DTYPE), json.loads(str(data["summary"]))
 
+    def recall(self, ctx: JobContext) -> None:
+        return None
+
+    def digest(self, ctx: JobContext) -> dict[str, Any]:
+        """The events' counts (:func:`demfem.assess.events.impact_events`' summary)."""
+        return dict(ctx.produced[self.name][1])
+
     def show(self, ctx: JobContext) -> None:
         from demfem.assess.events import count_line
 
-        ctx.log("  " + count_line(ctx.produced[self.name][1]))
+        ctx.log("  " + count_line(ctx.digests[self.name]))
 
 
 class StressStage(Stage):
@@ -281,7 +330,7 @@ class StressStage(Stage):
     product: the arrays of ``stress.npz``."""
 
     name = "stress"
-    files = ("stress.npz",)
+    intermediates = ("stress.npz",)
 
     def title(self, ctx: JobContext) -> str:
         return "force, duration, sigma1 and stressed area per event"
@@ -290,12 +339,12 @@ class StressStage(Stage):
     def _measured(ctx: JobContext) -> bool:
         """Whether the stresses take the DEM's measured forces: they hold at its modulus
         only."""
-        summary = ctx.produced["events"][1]
+        summary = ctx.digests["events"]
         return bool(summary.get("measured")) and math.isclose(
             float(ctx.table.young_modulus), ctx.stress_young_modulus, rel_tol=1e-12)
 
     def begin(self, ctx: JobContext) -> None:
-        summary, e_stress = ctx.produced["events"][1], ctx.stress_young_modulus
+        summary, e_stress = ctx.digests["events"], ctx.stress_young_modulus
         ctx.log("  forces: " + (
             "measured in the DEM (peak of each contact; duration from its impulse)"
             if self._measured(ctx) else "calibrated law at the onset speed"
@@ -326,12 +375,23 @@ class StressStage(Stage):
     def load(self, ctx: JobContext) -> dict[str, np.ndarray]:
         return load_npz(ctx.out / "stress.npz")
 
-    def show(self, ctx: JobContext) -> None:
+    def recall(self, ctx: JobContext) -> None:
+        return None
+
+    def digest(self, ctx: JobContext) -> dict[str, Any]:
+        """The number of events and their largest force and σ1 outside and inside."""
         stress = ctx.produced[self.name]
-        if len(ctx.produced["events"][0]):
-            ctx.log(f"  peak force up to {stress['force_N'].max():.3g} N, sigma1 up to "
-                    f"{stress['sigma_outer_Pa'].max() / 1e6:.3g} MPa outside and "
-                    f"{stress['sigma_inner_Pa'].max() / 1e6:.3g} MPa inside")
+        n = len(stress["force_N"])
+        return {"n_events": n, **({k: float(np.max(stress[k])) for k in
+                                   ("force_N", "sigma_outer_Pa", "sigma_inner_Pa")}
+                                  if n else {})}
+
+    def show(self, ctx: JobContext) -> None:
+        d = ctx.digests[self.name]
+        if d["n_events"]:
+            ctx.log(f"  peak force up to {_num(d['force_N']):.3g} N, sigma1 up to "
+                    f"{_num(d['sigma_outer_Pa']) / 1e6:.3g} MPa outside and "
+                    f"{_num(d['sigma_inner_Pa']) / 1e6:.3g} MPa inside")
 
 
 class RiskStage(Stage):

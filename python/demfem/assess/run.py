@@ -3,18 +3,25 @@ per cartridge, in six resumable stages (:data:`demfem.assess.stages.STAGES`):
 
 1. **calibration** — the cartridge's equivalent body, its Hertz–Reissner law and the stress
    model in use (``calibration.json``);
-2. **dem** — the table run (:func:`demfem.dem.table_run.run_table`, ``table_run.npz``;
-   checkpoints into ``table.ck`` and resumes mid-run);
-3. **events** — impact events above the minimum speed (``events.npz``);
-4. **stress** — force, duration, σ1 and stressed area per event (``stress.npz``);
+2. **dem** — the table run (:func:`demfem.dem.table_run.run_table`; checkpoints into
+   ``table.ck`` and resumes mid-run): ``table_run.npz`` (the record a finished folder
+   keeps: samples in single precision, without the whole contacts) and, until the job has
+   finished, ``table_run_full.npz`` (the whole record);
+3. **events** — impact events above the minimum speed (``events.npz``, until finished);
+4. **stress** — force, duration, σ1 and stressed area per event (``stress.npz``, until
+   finished);
 5. **risk** — P per event, per cartridge and per hour, steady state, worst events, risk map
-   (``risk.json``, ``events.parquet``, ``passages.parquet``, ``risk_arrays.npz``);
+   (``risk.json``, ``events.parquet``, ``passages.parquet``, ``events.vtp``,
+   ``cartridges.vtp``, ``risk_arrays.npz``);
 6. **report** — ``report.html`` and the figures.
 
 :func:`assess` checks its arguments, then goes through the stages
-(:data:`demfem.assess.job_stages.JOB_STAGES`, each a :class:`demfem.assess.job.Stage`) on one
-:class:`~demfem.assess.stages.StageBook`: a stage completed before is read back, any other
-runs, and the job ends after ``stop_after``.
+(:data:`demfem.assess.job_stages.JOB_STAGES`, each a :class:`demfem.assess.job.Stage`) with
+:func:`demfem.assess.job.run_stages` on one :class:`~demfem.assess.stages.StageBook`: a
+stage completed before is read back, any other runs, and the job ends after
+``stop_after``. Once the last stage has completed, the intermediates (``table_run_full.npz``,
+``events.npz``, ``stress.npz``) are removed: a finished default job keeps 96 MB instead of
+364 MB (docs/output-folders.md gives the files and their sizes).
 
 SI units throughout: m, s, kg, N, Pa.
 """
@@ -26,7 +33,7 @@ from pathlib import Path
 from typing import Any, Callable, Optional
 
 from demfem.assess.events import DEFAULT_MIN_SPEED
-from demfem.assess.job import JobContext
+from demfem.assess.job import JobContext, run_stages
 from demfem.assess.job_stages import JOB_STAGES
 from demfem.assess.stages import STAGES, StageBook
 from demfem.stress.stress_model import StressModel
@@ -76,7 +83,8 @@ def steady_rule(table, full: bool = False, min_speed: float = DEFAULT_MIN_SPEED)
                       excluded_walls=tuple(k for k, n in enumerate(names) if n in NOT_IMPACTS))
 
 #: Files the job writes (removed by a fresh start), besides the DEM checkpoint.
-OUTPUT_FILES = ("calibration.json", "table_run.npz", "events.npz", "stress.npz", "risk.json",
+OUTPUT_FILES = ("calibration.json", "table_run.npz", "table_run_full.npz", "events.npz",
+                "stress.npz", "risk.json",
                 "events.parquet", "passages.parquet", "events.csv", "passages.csv",
                 "events.vtp", "cartridges.vtp",
                 "risk_arrays.npz", "report.html")
@@ -245,21 +253,6 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
     # the folder's lock is held from here to the end, released on return or error
     book = StageBook(ctx.out, settings, fresh, OUTPUT_FILES)
     try:
-        for k, stage in enumerate(JOB_STAGES, 1):
-            done = book.is_done(stage.name)
-            log(f"== {k}/{len(JOB_STAGES)} {stage.name}: {stage.title(ctx)}"
-                + (" (done before: reused) ==" if done else " =="))
-            stage.begin(ctx)
-            if done:
-                ctx.produced[stage.name] = stage.load(ctx)
-            else:
-                output = stage.run(ctx)
-                book.complete(stage.name, output.files)
-                ctx.produced[stage.name] = (stage.load(ctx) if output.product is None
-                                            else output.product)
-            stage.show(ctx)
-            if stage.name == stop_after:
-                break
-        return stage.answer(ctx)
+        return run_stages(ctx, JOB_STAGES, book, stop_after)
     finally:
         book.close()
