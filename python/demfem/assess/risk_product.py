@@ -1,6 +1,9 @@
 """The risk stage's products: ``risk.json`` (strict JSON), ``events.parquet``,
-``passages.parquet`` (CSV on request) and ``risk_arrays.npz`` (the arrays the figures are drawn from), with the
-statement of what each number rests on (``basis``) and the warnings of the report."""
+``passages.parquet`` (CSV on request), ``events.vtp`` and ``cartridges.vtp`` (ParaView) and
+``risk_arrays.npz`` (the arrays the figures are drawn from that no other file holds: the risk
+map and each passage's P), with the statement of what each number rests on (``basis``) and
+the warnings of the report. Every one is kept in a finished folder; the per-event
+probabilities are in ``events.parquet`` only."""
 from __future__ import annotations
 
 import math
@@ -343,6 +346,5 @@ def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[st
                          csv)
     files += _write_vtk(out, run, events, p, stress, passages, pr, inside)
     files.append(save_npz(out / "risk_arrays.npz", p_window=pr["p_window"],
-                          p_event=p["p_event"],
                           **{f"map_{k}": v for k, v in rmap.items()}))
     return files

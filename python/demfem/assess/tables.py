@@ -4,7 +4,17 @@ with its SI unit and carrying it in the Parquet schema (field metadata ``unit``)
 CSV on request (``csv=True``). :func:`load_assessment` reads a finished assessment folder
 back into pandas DataFrames and the summary.
 
-Written atomically (:mod:`demfem.io.atomic`); zstd-compressed.
+Written atomically (:mod:`demfem.io.atomic`); zstd-compressed, real columns byte-stream
+split (lossless, about 12 % smaller for doubles) and increasing integer columns (the row
+numbers) delta-encoded.
+
+Precision of ``events.parquet``: double (float64) for every number the probabilities are
+computed from and the probabilities themselves — ``time_s``, ``force_N``, ``duration_s``,
+``sigma_inner_Pa``, ``sigma_outer_Pa``, ``area_inner_m2``, ``area_outer_m2``, ``p_inner``,
+``p_outer``, ``p_event`` — so that P can be recomputed from the table to 1e-9; single
+(float32, 7 significant digits) for the descriptive columns :data:`SINGLE_PRECISION_COLUMNS`
+(contact point, speeds, angle, friction force, contact radius, the law's force). The CSV
+files hold the same values.
 """
 from __future__ import annotations
 
@@ -19,7 +29,13 @@ import numpy as np
 from demfem.errors import DemfemIOError
 
 __all__ = ["write_table", "events_columns", "passages_columns", "load_assessment",
-           "Assessment"]
+           "Assessment", "SINGLE_PRECISION_COLUMNS"]
+
+#: The columns of ``events.parquet`` held in single precision (float32): descriptive, no
+#: probability is computed from them (module docstring).
+SINGLE_PRECISION_COLUMNS = ("x_m", "y_m", "z_m", "normal_speed_m_per_s",
+                            "tangential_speed_m_per_s", "impact_angle_deg",
+                            "peak_tangential_force_N", "contact_radius_m", "law_force_N")
 
 
 def _unit(name: str) -> str:
@@ -32,24 +48,33 @@ def _unit(name: str) -> str:
 
 def write_table(path: Path, columns: dict[str, Any], csv: bool = False) -> list[Path]:
     """Write ``columns`` ({name: (n,) array}) as Parquet at ``path`` (the unit of each column,
-    from its name's suffix, in the schema's field metadata) and, with ``csv``, as CSV beside
-    it; returns the files written."""
+    from its name's suffix, in the schema's field metadata; each column in its array's
+    dtype) and, with ``csv``, as CSV beside it; returns the files written. Real columns are
+    byte-stream split, integer columns that never decrease delta-encoded, the others
+    dictionary-encoded; all zstd-compressed (lossless)."""
     import pyarrow as pa
     import pyarrow.parquet as pq
 
     from demfem.io.atomic import atomic_path, write_text_atomic
 
     fields, arrays = [], []
+    encoding: dict[str, str] = {}
     for name, values in columns.items():
         a = np.asarray(values)
         arr = pa.array(a) if a.dtype.kind != "U" else pa.array(a.tolist()).dictionary_encode()
         fields.append(pa.field(name, arr.type, metadata={"unit": _unit(name)}))
         arrays.append(arr)
+        if a.dtype.kind == "f":
+            encoding[name] = "BYTE_STREAM_SPLIT"
+        elif a.dtype.kind == "i" and a.size > 1 and bool(np.all(np.diff(a) >= 0)):
+            encoding[name] = "DELTA_BINARY_PACKED"
     table = pa.Table.from_arrays(arrays, schema=pa.schema(
         fields, metadata={"producer": "demfem assess", "units": "SI, per column"}))
     path = Path(path)
     with atomic_path(path, suffix=".parquet") as tmp:
-        pq.write_table(table, str(tmp), compression="zstd")
+        pq.write_table(table, str(tmp), compression="zstd",
+                       use_dictionary=[n for n in columns if n not in encoding],
+                       column_encoding=encoding or None)
     out = [path]
     if csv:
         lines = [",".join(columns)]
@@ -75,19 +100,22 @@ def events_columns(events: np.ndarray, extra: dict[str, np.ndarray],
                    wall_names: list[str]) -> dict[str, Any]:
     """The columns of ``events.parquet``: the event table
     (:data:`demfem.assess.events.EVENT_DTYPE`) with its partner and wall named, then
-    ``extra`` (per-event arrays, named with their units)."""
+    ``extra`` (per-event arrays, named with their units); the columns named in
+    :data:`SINGLE_PRECISION_COLUMNS` in single precision."""
     from demfem.assess.impact import PARTNERS
 
     partner = np.array([PARTNERS[int(p)] for p in events["partner"]], dtype="U8")
     wall = np.asarray(events["wall"], np.int64)
     names = np.array([wall_names[w] if 0 <= w < len(wall_names) else "" for w in wall],
                      dtype="U32")
-    return {"event": np.arange(len(events), dtype=np.int64), "i": events["i"],
-            "j": events["j"], "partner": partner, "wall": names, "time_s": events["time"],
-            "x_m": events["x"], "y_m": events["y"], "z_m": events["z"],
-            "normal_speed_m_per_s": events["normal_speed"],
-            "tangential_speed_m_per_s": events["tangential_speed"],
-            "impact_angle_deg": np.degrees(events["impact_angle"]), **extra}
+    columns = {"event": np.arange(len(events), dtype=np.int64), "i": events["i"],
+               "j": events["j"], "partner": partner, "wall": names, "time_s": events["time"],
+               "x_m": events["x"], "y_m": events["y"], "z_m": events["z"],
+               "normal_speed_m_per_s": events["normal_speed"],
+               "tangential_speed_m_per_s": events["tangential_speed"],
+               "impact_angle_deg": np.degrees(events["impact_angle"]), **extra}
+    return {k: np.asarray(v, np.float32) if k in SINGLE_PRECISION_COLUMNS else v
+            for k, v in columns.items()}
 
 
 def passages_columns(passages: np.ndarray, tags: np.ndarray,
