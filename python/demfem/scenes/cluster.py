@@ -549,25 +549,44 @@ def cluster_from_run(run: Any, which: str = "max", **overrides: Any) -> Cartridg
             raise DemfemIOError(f"invalid run {path}: no table run there (a demfem run or "
                                 "demfem assess folder holds table_run.npz)")
         run = TableRun.load(f)
-        if not len(run.onsets) and (f.parent / "events.npz").is_file():
+        if not len(run.onsets) and ((f.parent / "events.npz").is_file()
+                                    or (f.parent / "events.parquet").is_file()):
             # an assessment keeps the digest of its onsets, and its events
-            return _cluster_from_events(run, f.parent / "events.npz", which, overrides)
+            return _cluster_from_events(run, f.parent, which, overrides)
     table = run.table
     values = {"cartridge": table.cartridge, "friction": table.friction, **overrides}
     return CartridgeCluster.from_collisions(run.onsets, which=which, **values)
 
 
-def _cluster_from_events(run: Any, path: Path, which: str,
+def _cluster_from_events(run: Any, folder: Path, which: str,
                          overrides: dict[str, Any]) -> CartridgeCluster:
-    """:func:`cluster_from_run` from an assessment's events (cartridge–cartridge impacts)."""
+    """:func:`cluster_from_run` from an assessment's events (cartridge–cartridge impacts):
+    its ``events.npz`` while the job is unfinished, else its ``events.parquet`` (speeds and
+    angle in single precision there)."""
     from demfem.analysis.collisions import ONSET_DTYPE
 
-    with np.load(path, allow_pickle=False) as data:
-        ev = data["events"]
-    ev = ev[ev["partner"] == 0]
-    onsets = np.zeros(len(ev), ONSET_DTYPE)
-    for k in ("i", "j", "time", "normal_speed", "tangential_speed", "impact_angle"):
-        onsets[k] = ev[k]
+    if (folder / "events.npz").is_file():
+        with np.load(folder / "events.npz", allow_pickle=False) as data:
+            ev = data["events"]
+        ev = ev[ev["partner"] == 0]
+        columns = {k: ev[k] for k in ("i", "j", "time", "normal_speed", "tangential_speed",
+                                      "impact_angle")}
+    else:
+        import pyarrow.parquet as pq
+
+        from demfem.assess.impact import PARTNERS
+
+        names = {"i": "i", "j": "j", "time": "time_s", "normal_speed": "normal_speed_m_per_s",
+                 "tangential_speed": "tangential_speed_m_per_s",
+                 "impact_angle": "impact_angle_deg"}
+        rows = pq.read_table(folder / "events.parquet", columns=[*names.values(), "partner"])
+        sphere = np.asarray(rows.column("partner").cast("string").to_numpy(
+            zero_copy_only=False) == PARTNERS[0])
+        columns = {k: rows.column(n).to_numpy()[sphere] for k, n in names.items()}
+        columns["impact_angle"] = np.radians(np.asarray(columns["impact_angle"], float))
+    onsets = np.zeros(len(columns["i"]), ONSET_DTYPE)
+    for k, v in columns.items():
+        onsets[k] = v
     table = run.table
     values = {"cartridge": table.cartridge, "friction": table.friction, **overrides}
     return CartridgeCluster.from_collisions(onsets, which=which, **values)
