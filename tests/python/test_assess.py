@@ -236,6 +236,128 @@ def test_interrupted_assess_resumes_to_the_same_numbers(small_job, tmp_path):
     assert other["summary"]["throughput_per_hour"] == 100.0
 
 
+#: The files a finished job removes: the stages' intermediates.
+INTERMEDIATES = {"table_run_full.npz", "events.npz", "stress.npz"}
+
+
+def _job(out, log, **kwargs):
+    """The small job of ``small_job`` into ``out``."""
+    return assess(SMALL, out=out, duration=0.12, sample_interval=0.01, log=log, csv=True,
+                  **kwargs)
+
+
+def _lines(lines, out):
+    """Console lines as a rerun in another folder prints them: without the reuse marks, the
+    folder named as OUT and the DEM's wall time left out."""
+    return [re.sub(r", wall [0-9.]+ s$", "", line.replace(" (done before: reused)", "")
+                   .replace(str(out), "OUT")) for line in lines]
+
+
+def _digests(out):
+    from demfem.jobs import sha256_file
+
+    return {p.name: sha256_file(p) for p in out.iterdir() if p.name != ".demfem.lock"}
+
+
+def test_a_finished_folder_keeps_its_products_only_and_a_rerun_reuses_them(small_job):
+    """The intermediates (the whole DEM record, events.npz, stress.npz) are gone once the job
+    has finished; stages.json says so and holds the digests the console lines need. The same
+    command again reuses every stage, changes no file, prints the same lines and returns the
+    same document; the kept DEM record holds its samples in single precision and refuses to
+    give events again; load_assessment reads the folder."""
+    from demfem.analysis.contact_events import CONTACT_EVENT_DTYPE
+    from demfem.assess.events import impact_events
+    from demfem.assess.tables import load_assessment
+    from demfem.dem.table_run import TableRun
+
+    out, risk, lines = small_job
+    names = {p.name for p in out.iterdir()}
+    assert not names & INTERMEDIATES
+    assert {"calibration.json", "table_run.npz", "risk.json", "events.parquet",
+            "passages.parquet", "events.csv", "passages.csv", "events.vtp", "cartridges.vtp",
+            "risk_arrays.npz", "report.html", "stages.json", *FIGURES} <= names
+    book = json.loads((out / "stages.json").read_text())
+    assert book["finished"] is True
+    assert book["dropped"] == {"dem": ["table_run_full.npz"], "events": ["events.npz"],
+                               "stress": ["stress.npz"]}
+    assert set(book["digests"]) == {"events", "stress"}
+    assert book["digests"]["events"] == risk["events"]  # the counts risk.json states
+    assert not set(book["files"]) & INTERMEDIATES
+    before = _digests(out)
+    again = []
+    assert _job(out, again.append) == risk
+    assert "\n".join(again).count("(done before: reused)") == len(STAGES)
+    assert [line.replace(" (done before: reused)", "") for line in again] == lines
+    assert _digests(out) == before  # nothing written, nothing removed
+    run = TableRun.load(out / "table_run.npz")
+    assert run.positions.dtype == np.float32 and run.velocities.dtype == np.float32
+    assert run.times.dtype == np.float64 and run.info["events_recorded"]
+    assert run.contact_events.dtype == CONTACT_EVENT_DTYPE and len(run.contact_events) == 0
+    with pytest.raises(InvalidParameterError, match="events.parquet"):
+        impact_events(run)
+    a = load_assessment(out)
+    assert len(a.events) == risk["events"]["n_events"] and a.summary == risk["summary"]
+    assert a.events["p_event"].dtype == np.float64 and a.events["x_m"].dtype == np.float32
+    with np.load(out / "risk_arrays.npz") as arrays:
+        assert "p_event" not in arrays.files and "map_hazard" in arrays.files
+
+
+@pytest.mark.parametrize("stop", ["events", "stress"])
+def test_a_job_stopped_after_its_events_or_stresses_resumes_to_the_same_numbers(
+        small_job, tmp_path, stop):
+    """Stopped after the events (or the stresses), the folder keeps every intermediate so far
+    and is not finished; resumed, it ends with the uninterrupted job's numbers, tables and
+    console lines, and keeps only the products. A cluster load case taken from the folder
+    is the same from its events.npz (unfinished) and its events.parquet (finished, speeds in
+    single precision)."""
+    from demfem.scenes.cluster import cluster_from_run
+
+    full_out, full, full_lines = small_job
+    out = tmp_path / "job"
+    lines = []
+    assert _job(out, lines.append, stop_after=stop) == {"stopped_after": stop}
+    names = {p.name for p in out.iterdir()}
+    assert {"table_run.npz", "table_run_full.npz", "events.npz"} <= names
+    assert ("stress.npz" in names) == (stop == "stress") and "risk.json" not in names
+    book = json.loads((out / "stages.json").read_text())
+    assert "finished" not in book and set(book["completed"]) == set(
+        STAGES[:STAGES.index(stop) + 1])
+    from_npz = cluster_from_run(out)
+    lines = []
+    resumed = _job(out, lines.append)
+    assert "\n".join(lines).count("(done before: reused)") == STAGES.index(stop) + 1
+    assert resumed == full
+    assert _lines(lines, out) == _lines(full_lines, full_out)
+    assert not {p.name for p in out.iterdir()} & INTERMEDIATES
+    assert (out / "events.csv").read_text() == (full_out / "events.csv").read_text()
+    import pyarrow.parquet as pq
+
+    for name in ("events.parquet", "passages.parquet"):
+        assert pq.read_table(out / name).to_pandas().equals(
+            pq.read_table(full_out / name).to_pandas()), name
+    from_parquet = cluster_from_run(out)
+    for k in ("v2", "v3", "direction_2_deg", "direction_3_deg"):
+        assert getattr(from_parquet, k) == pytest.approx(getattr(from_npz, k), rel=1e-6), k
+
+
+def test_a_finished_folder_with_a_damaged_product_is_redone_from_the_dem(small_job, tmp_path):
+    """A finished folder cannot rerun a later stage alone (the intermediates are gone): a
+    damaged product makes the job redo it from the DEM, to the same numbers."""
+    import shutil
+
+    full_out, full, _ = small_job
+    out = tmp_path / "job"
+    shutil.copytree(full_out, out)
+    (out / "events.parquet").write_bytes(b"damaged")
+    lines = []
+    assert _job(out, lines.append) == full
+    text = "\n".join(lines)
+    assert "1/6 calibration: equivalent body, contact law and stress model (done before" in text
+    assert text.count("(done before: reused)") == 1
+    assert not {p.name for p in out.iterdir()} & INTERMEDIATES
+    assert (out / "events.csv").read_text() == (full_out / "events.csv").read_text()
+
+
 def test_outputs_and_report(small_job):
     out, risk, _ = small_job
     doc = json.loads((out / "risk.json").read_text())  # strict JSON: parses
@@ -505,4 +627,6 @@ def test_the_job_goes_through_its_stages_in_order_and_names_their_files():
     from demfem.assess.run import OUTPUT_FILES
 
     assert tuple(stage.name for stage in JOB_STAGES) == STAGES
-    assert {f for stage in JOB_STAGES for f in stage.files} == {*OUTPUT_FILES, *FIGURES}
+    assert {f for stage in JOB_STAGES for f in (*stage.files, *stage.intermediates)} == {
+        *OUTPUT_FILES, *FIGURES}
+    assert {f for stage in JOB_STAGES for f in stage.intermediates} == INTERMEDIATES
