@@ -13,6 +13,7 @@ the same events:
 * ``contact, parallel``: two cartridges along the body (line contacts).
 
     python benches/stress_model_comparison.py [--duration 6] [--out demfem_out/model_cmp]
+    python benches/stress_model_comparison.py --folder RUN   # one existing folder's events
 
 Writes ``docs/data/stress_model_comparison.json`` and prints a table. SI units; hourly
 numbers per hour.
@@ -88,7 +89,26 @@ def main() -> None:
     ap.add_argument("--speeds", default="0.1,0.2,0.3", help="belt speeds, m/s")
     ap.add_argument("--out", default="demfem_out/model_cmp")
     ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--folder", default=None,
+                    help="instead of running the belt speeds: evaluate the variants on one "
+                         "assessment folder of the default table that still holds its "
+                         "events.npz (a job stopped after its events stage, or unfinished); "
+                         "prints the hourly numbers")
     args = ap.parse_args()
+    if args.folder is not None:
+        folder = Path(args.folder)
+        if not (folder / "events.npz").is_file():
+            ap.error(f"{folder / 'events.npz'} is missing: a finished assessment keeps no "
+                     "events.npz; run this bench's belt speeds, or stop a job after its "
+                     "events stage")
+        table = dataclasses.replace(AccumulationTable(), refeed=True)
+        for name, var in VARIANTS.items():
+            r = evaluate(folder, table, var)
+            print(f"{name:30s} {r['broken_per_hour']:.3g} per hour [{r['ci95'][0]:.3g}, "
+                  f"{r['ci95'][1]:.3g}]  outer share {r['outer_share']:.4f}  max sigma1 "
+                  f"outer {r['max_sigma_outer_MPa']:.3g} MPa, inner "
+                  f"{r['max_sigma_inner_MPa']:.3g} MPa")
+        return
     rows = {}
     for v in (float(x) for x in args.speeds.split(",")):
         table = dataclasses.replace(AccumulationTable(), belt_velocity=v, refeed=True)
