@@ -115,11 +115,22 @@ def test_ctrl_c_stops_cleanly_at_a_step_boundary():
     from demfem.errors import SimulationInterrupted
 
     sim = dem.DemSimulation._anchor_table(1e8, start="square")
-    timer = threading.Timer(0.3, _thread.interrupt_main)  # what Ctrl-C does
-    timer.start()
-    with pytest.raises(SimulationInterrupted):
-        sim.step(10_000_000, chunk=100)
-    timer.cancel()
+    interrupted = False
+    for _ in range(3):
+        timer = threading.Timer(0.3, _thread.interrupt_main)  # what Ctrl-C does
+        timer.start()
+        try:
+            sim.step(10_000_000, chunk=100)
+        except SimulationInterrupted:
+            interrupted = True
+            break
+        except KeyboardInterrupt:
+            # a starved process (a loaded machine) can take the signal before the step
+            # begins: Python raises it, not the engine; try again
+            continue
+        finally:
+            timer.cancel()
+    assert interrupted
     assert 0 < sim.steps < 10_000_000
     assert sim.time == pytest.approx(sim.steps * sim.dt, rel=1e-9)
     assert np.isfinite(sim.positions()).all()

@@ -105,12 +105,23 @@ def test_ctrl_c_is_seen_within_a_second_even_with_one_huge_chunk():
     import threading
 
     sim = dem.DemSimulation._anchor_table(1e8, start="square")
-    timer = threading.Timer(0.3, _thread.interrupt_main)
-    start = time.perf_counter()
-    timer.start()
-    with pytest.raises(SimulationInterrupted):
-        sim.step(10**9, chunk=10**9)
-    timer.cancel()
+    interrupted = False
+    for _ in range(3):
+        timer = threading.Timer(0.3, _thread.interrupt_main)
+        start = time.perf_counter()
+        timer.start()
+        try:
+            sim.step(10**9, chunk=10**9)
+        except SimulationInterrupted:
+            interrupted = True
+            break
+        except KeyboardInterrupt:
+            # a starved process (a loaded machine) can take the signal before the step
+            # begins: Python raises it, not the engine; try again
+            continue
+        finally:
+            timer.cancel()
+    assert interrupted
     # slices of ~0.1 s of engine time: seen at once (the bound is loose for a loaded
     # machine; without slicing the call would run 10^9 steps, hours)
     assert time.perf_counter() - start < 5.0
