@@ -11,6 +11,10 @@ On each window, with that window's events only:
   Student-t on the log scale: :func:`demfem.risk.interval.rate_interval`), is compared with
   the hourly number of the **held-back periods** (every other whole period of the run). The
   window's interval *covers* when the held-back number lies inside it.
+* **the rare-period check** (:func:`demfem.risk.rare_periods.period_dominance`, what
+  ``risk.json``'s ``period_check`` and the report say): whether one period of the window
+  dominates its hazard (a jam), and otherwise how rare such periods must be for the window
+  to have missed them.
 * **the tail model** (:func:`demfem.risk.tail.fit_tail` on the window's cartridge–cartridge
   peak forces, threshold by the documented diagnostic) predicts how often an impact harder
   than the hardest of the window happens (:func:`~demfem.risk.tail.expected_beyond` with a
@@ -39,6 +43,7 @@ from demfem.assess.tables import load_assessment
 from demfem.errors import InvalidParameterError
 from demfem.io.strict_json import write_json_atomic
 from demfem.risk.interval import rate_interval
+from demfem.risk.rare_periods import period_dominance
 from demfem.risk.tail import expected_beyond, fit_tail
 
 OUT = Path(__file__).resolve().parent.parent / "docs" / "data" / "interval_coverage.json"
@@ -58,6 +63,10 @@ def windows_check(times: np.ndarray, h: np.ndarray, force: np.ndarray, pair: np.
                   start: float, period: float, n_periods: int, k: int) -> list[dict[str, Any]]:
     """The rows of the check for windows of ``k`` periods (module docstring)."""
     end = start + n_periods * period
+    run_check = period_dominance(times, h, (start, end), period)
+    jam = np.zeros(times.shape, bool)         # the whole run's dominant periods
+    for d in run_check.dominant:
+        jam |= (times >= start + d * period) & (times < start + (d + 1) * period)
     out: list[dict[str, Any]] = []
     for i in range(n_periods // k):
         a, b = start + i * k * period, start + (i + 1) * k * period
@@ -74,6 +83,18 @@ def windows_check(times: np.ndarray, h: np.ndarray, force: np.ndarray, pair: np.
             "upper_per_h": ci.upper, "factor": ci.factor, "held_back_per_h": truth,
             "held_back_lower_per_h": ci_held.lower, "held_back_upper_per_h": ci_held.upper,
             "covers": bool(ci.lower <= truth <= ci.upper)}
+        dom = period_dominance(times[inside], h[inside], (a, b), period)
+        # the held-back ordinary periods: without the run's dominant ones
+        held_o = held & ~jam
+        w_o = w_held - period * sum(1 for d in run_check.dominant
+                                    if not a <= start + d * period < b)
+        truth_o = 3600.0 * float(h[held_o].sum()) / w_o
+        row["held_back_ordinary_per_h"] = truth_o
+        row["covers_ordinary"] = bool(ci.lower <= truth_o <= ci.upper)
+        row["period_check"] = {"dominated": dom.dominated,
+                               "largest_over_median": dom.largest_over_median,
+                               "largest_share": dom.largest_share,
+                               "unseen_bound": dom.unseen_bound}
         f_win = force[inside & pair]
         try:
             model = fit_tail(f_win, b - a)
@@ -125,12 +146,21 @@ def main() -> None:
         rows = windows_check(times, h, force, pair, a.warmup, period, n_periods, k)
         covered = sum(r["covers"] for r in rows)
         tails = [r["tail"] for r in rows if "covers" in r["tail"]]
+        flagged = sum(r["period_check"]["dominated"] for r in rows)
+        quiet = [r for r in rows if not r["period_check"]["dominated"]]
+        cov_o = sum(r["covers_ordinary"] for r in quiet)
         doc["windows"][str(k)] = {"rows": rows, "covered": covered, "n": len(rows),
+                                  "flagged_dominated": flagged,
+                                  "unflagged_covering_ordinary": cov_o,
+                                  "unflagged": len(quiet),
                                   "tail_covered": sum(t["covers"] for t in tails),
                                   "tail_n": len(tails)}
         print(f"\nwindows of {k} periods: the interval holds the held-back number in "
               f"{covered} of {len(rows)}; the tail model's prediction in "
-              f"{sum(t['covers'] for t in tails)} of {len(tails)}")
+              f"{sum(t['covers'] for t in tails)} of {len(tails)}; {flagged} window(s) "
+              "flagged as dominated by one period; the unflagged windows' intervals hold the "
+              f"held-back ordinary periods' number (the run's dominant periods left out) in "
+              f"{cov_o} of {len(quiet)}")
         print("  window s      estimate  95 % interval          factor  held back [its 95 %]"
               "            tail: beyond largest, predicted /s [95 %]  held back count")
         for r in rows:
@@ -141,7 +171,9 @@ def main() -> None:
             print(f"  {r['window_s'][0]:5.1f}-{r['window_s'][1]:5.1f}  {r['estimate_per_h']:.3g}"
                   f"  [{r['lower_per_h']:.3g}, {r['upper_per_h']:.3g}]  x{r['factor']:.1f}  "
                   f"{r['held_back_per_h']:.3g} [{r['held_back_lower_per_h']:.3g}, "
-                  f"{r['held_back_upper_per_h']:.3g}]  {'in ' if r['covers'] else 'OUT'}  {tail}")
+                  f"{r['held_back_upper_per_h']:.3g}]  {'in ' if r['covers'] else 'OUT'}  {tail}"
+                  f"  largest period x{r['period_check']['largest_over_median']:.3g} the median"
+                  + ("  DOMINATED" if r["period_check"]["dominated"] else ""))
     Path(a.out).parent.mkdir(parents=True, exist_ok=True)
     write_json_atomic(a.out, doc)
     print(f"\n-> {a.out}")

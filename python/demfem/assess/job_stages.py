@@ -425,7 +425,11 @@ class RiskStage(Stage):
     def show(self, ctx: JobContext) -> None:
         from demfem.assess.headline import headline
 
-        ctx.log("  " + headline(ctx.produced[self.name]["summary"]))
+        risk = ctx.produced[self.name]
+        ctx.log("  " + headline(risk["summary"]))
+        check = risk.get("period_check") or {}
+        if check.get("dominated"):
+            ctx.log("  Warning: " + check["text"])
 
     def answer(self, ctx: JobContext) -> dict[str, Any]:
         return ctx.produced[self.name]

@@ -106,6 +106,9 @@ def render_report(risk: dict[str, Any], figures: dict[str, bytes],
                                f"{fmt(100 * (d.get('share') or 0))} %{rng}"))
             if rows_s:
                 parts.append(_table(rows_s, (names[group], "share of the hazard")))
+    check = risk.get("period_check") or {}
+    if check.get("text") and not check.get("dominated"):
+        parts.append("<h3>Rare periods</h3><p>" + html.escape(check["text"]) + "</p>")
     parts.append("<h2>Worst collisions</h2><p>An impact began at least at the minimum "
                  "speed; a contact pressed by the queue began slower but the DEM pressed it to "
                  "at least the force of an impact at that speed.</p>"
