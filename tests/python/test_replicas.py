@@ -137,6 +137,30 @@ def test_two_replicas_on_a_local_cluster(first_set):
         assert r["broken_per_hour"] == pytest.approx(risk["summary"]["broken_per_hour"],
                                                      rel=1e-9)
     assert m["n"] == 2 and m["dof"] == 1 and 0 < m["lower"] < m["estimate"] < m["upper"]
+    # 0.1-s replicas hold no whole gate period: nothing checked, nothing claimed
+    assert m["dominant_periods"]["periods"] == 0 and m["dominant_periods"]["ci"] is None
+
+
+def test_jams_are_counted_over_the_replicas_periods():
+    """Replicas measure how often a gate period is dominated by one event, which one run of
+    a few periods cannot: k of N with its Clopper-Pearson interval."""
+    from scipy import stats
+
+    from demfem.assess.replica_stats import dominant_periods
+
+    recs = [{"name": f"replica_{k}", "periods_checked": 7, "dominant_periods": int(k == 2)}
+            for k in range(6)]
+    d = dominant_periods(recs)
+    assert (d["dominant"], d["periods"], d["replicas"]) == (1, 42, ["replica_2"])
+    assert d["fraction"] == pytest.approx(1 / 42)
+    lo, hi = d["ci"]
+    # the exact binomial interval: P(X >= 1 | lo) = P(X <= 1 | hi) = 2.5 %
+    assert stats.binom.sf(0, 42, lo) == pytest.approx(0.025, rel=1e-9)
+    assert stats.binom.cdf(1, 42, hi) == pytest.approx(0.025, rel=1e-9)
+    none = dominant_periods([dict(r, dominant_periods=0) for r in recs])
+    assert none["ci"][0] == 0.0 and (1 - none["ci"][1]) ** 42 == pytest.approx(0.025)
+    with pytest.raises(InvalidParameterError, match="confidence"):
+        dominant_periods(recs, confidence=1.5)
 
 
 def test_a_lost_replica_is_resumed_alone_with_the_same_numbers(first_set, tmp_path):

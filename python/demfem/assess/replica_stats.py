@@ -41,6 +41,7 @@ from scipy import stats
 from demfem.errors import InvalidParameterError, check_count, check_range
 
 __all__ = ["RatioInterval", "ratio_interval", "replica_numbers", "merge_replicas",
+           "dominant_periods",
            "stopping_half_width", "precision_met", "PRECISION_MIN_REPLICAS",
            "PRECISION_SPREAD_CONFIDENCE", "simulate_replicas", "coverage", "COVERAGE_METHODS"]
 
@@ -187,7 +188,10 @@ def replica_numbers(risk: dict[str, Any]) -> dict[str, Any]:
     user = s.get("throughput_source") == "user"
     hours = exits / float(s["throughput_per_hour"]) if user and exits > 0 else w / 3600.0
     steady = risk.get("steady_state") or {}
+    check = risk.get("period_check") or {}
     return {"window_s": [t0, t1], "expected_broken": y, "hours": hours,
+            "periods_checked": int(check.get("n_periods") or 0),
+            "dominant_periods": len(check.get("dominant_periods") or ()),
             "broken_per_hour": y / hours, "broken_per_hour_reported": s.get("broken_per_hour"),
             "throughput_source": s.get("throughput_source"),
             "throughput_per_hour": s.get("throughput_per_hour"), "exits_window": exits,
@@ -195,6 +199,23 @@ def replica_numbers(risk: dict[str, Any]) -> dict[str, Any]:
             "max_force_N": s.get("max_force_N"), "steady": bool(steady.get("steady")),
             "hazard_relative_error": steady.get("hazard_relative_error"),
             "settings": risk.get("settings", {})}
+
+
+def dominant_periods(records: Sequence[dict[str, Any]],
+                     confidence: float = 0.95) -> dict[str, Any]:
+    """How often one gate period dominates a replica's hazard (a jam,
+    :mod:`demfem.risk.rare_periods`), pooled over replicas: k dominant periods of N checked,
+    the fraction k / N with its Clopper–Pearson interval, and the replicas that had one.
+    This is what a single run cannot measure and replicas can."""
+    k = sum(int(r.get("dominant_periods") or 0) for r in records)
+    n = sum(int(r.get("periods_checked") or 0) for r in records)
+    conf = check_range("confidence", confidence, 0.0, 1.0)
+    a = (1.0 - conf) / 2.0
+    lo = 0.0 if k == 0 or n == 0 else float(stats.beta.ppf(a, k, n - k + 1))
+    hi = (1.0 if n == 0 else 1.0 if k == n else float(stats.beta.ppf(1.0 - a, k + 1, n - k)))
+    return {"dominant": k, "periods": n, "fraction": k / n if n else None,
+            "ci": [lo, hi] if n else None, "confidence": conf,
+            "replicas": [r.get("name") for r in records if r.get("dominant_periods")]}
 
 
 def _comparable(settings: dict[str, Any]) -> dict[str, Any]:
@@ -245,6 +266,7 @@ def merge_replicas(records: Sequence[dict[str, Any]],
             "window_total_s": float(w.sum()),
             "n_events_window": int(sum(r["n_events_window"] for r in records)),
             "per_replica": [float(x) for x in per],
+            "dominant_periods": dominant_periods(records, confidence),
             "between_replica_cv": (float(np.std(per, ddof=1) / np.mean(per))
                                    if len(per) > 1 and np.mean(per) > 0 else None),
             "replicas": [r.get("name") for r in records],

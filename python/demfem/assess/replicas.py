@@ -441,6 +441,13 @@ def summary_lines(doc: dict[str, Any]) -> list[str]:
         lines.append(f"  {m['n_events_window']} events over {m['window_total_s']:.4g} s of "
                      f"statistics windows; replicas' hourly numbers "
                      + ", ".join(f"{x:.3g}" for x in m["per_replica"]))
+    dp = m.get("dominant_periods") or {}
+    if dp.get("periods"):
+        lo, hi = dp["ci"]
+        lines.append(f"  gate periods dominated by one event (jams): {dp['dominant']} of "
+                     f"{dp['periods']} ({dp['fraction']:.1%}, {dp['confidence']:.0%}: "
+                     f"{lo:.1%} - {hi:.1%})"
+                     + (f" in {', '.join(dp['replicas'])}" if dp["replicas"] else ""))
     note = doc["precision"].get("note")
     if note:
         lines.append(f"  precision: {note}")
