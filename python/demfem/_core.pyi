@@ -20,10 +20,18 @@ __all__ = [
     "fem_solve_static",
     "fem_stress_invariants",
     "fem_tet_mesh",
+    "effective_mass",
+    "effective_modulus",
+    "effective_radius",
     "hertz_impact_duration",
+    "hertz_max_overlap",
+    "hertz_stiffness",
+    "linearized_hertz_stiffness",
     "max_impact_force",
     "normal_force",
     "rayleigh_time_step",
+    "reissner_stiffness",
+    "series_stiffness",
     "tsuji_damping_for_restitution",
     "tsuji_restitution",
     "__version__",
@@ -60,6 +68,34 @@ def rayleigh_time_step(radius: float, E: float, nu: float, density: float) -> fl
 def hertz_impact_duration(k_h: float, m_star: float, v_rel: float) -> float:
     """Duration (s) of an undamped Hertz impact: k_h (N/m^1.5), m_star (kg), v_rel (m/s)
     (:func:`demfem.contact.hertz_contact_duration` takes the two bodies instead)."""
+
+def effective_modulus(E1: float, nu1: float, E2: float, nu2: float) -> float:
+    """E* (Pa) from 1/E* = (1-nu1^2)/E1 + (1-nu2^2)/E2 (eq. 4); ``E2 = inf``: a rigid
+    partner. As :func:`demfem.contact.effective_modulus`."""
+
+def effective_radius(R1: float, R2: float) -> float:
+    """R* (m) from 1/R* = 1/R1 + 1/R2 (eq. 3); ``R2 = inf``: a plane."""
+
+def effective_mass(m1: float, m2: float) -> float:
+    """m* (kg) from 1/m* = 1/m1 + 1/m2 (eq. 9); ``m2 = inf``: an immovable partner."""
+
+def hertz_stiffness(R_star: float, E_star: float) -> float:
+    """Hertz stiffness 4/3 sqrt(R*) E* (eq. 2), N/m^1.5, from the effective radius (m) and
+    modulus (Pa) (:func:`demfem.contact.hertz_stiffness` takes both bodies instead)."""
+
+def reissner_stiffness(E: float, nu: float, t: float, R: float) -> float:
+    """Reissner stiffness of a thin shallow shell (eq. 6), N/m: E (Pa), nu, thickness t (m),
+    mid-surface radius R (m), 0 < t < R."""
+
+def series_stiffness(k1: float, k2: float) -> float:
+    """Springs in series, 1/k = 1/k1 + 1/k2, N/m; ``inf`` for a spring that does not deflect."""
+
+def linearized_hertz_stiffness(R_star: float, E_star: float, m_star: float, v_rel: float) -> float:
+    """Linearised Hertz stiffness (eq. 13), N/m, from R* (m), E* (Pa), m* (kg), v_rel (m/s)."""
+
+def hertz_max_overlap(k_h: float, m_star: float, v_rel: float) -> float:
+    """Maximum overlap (m) of an undamped Hertz impact, (5 m* v^2 / (4 k_h))^(2/5): k_h
+    (N/m^1.5), m_star (kg), v_rel (m/s)."""
 
 @final
 class DemSimulation:

@@ -7,19 +7,22 @@ and, from the energy balance of the impact (eqs. 7–11), gets the maximum conta
 root of eq. 12; eqs. 13–15 give an explicit linearised alternative. SI units throughout: m,
 kg, s, N, Pa.
 
-The same normal laws live in the Rust core (``demfem._core``), which the DEM uses; the test
-suite checks that both agree to 1e-12 relative and that both obey the closed forms.
+The laws are written once, in the Rust core (``demfem._core``, the crate's ``contact``
+module), which the DEM uses. This module is their documented Python front: each function
+validates its inputs here (errors name the field) and computes through the core. The tests
+check the core against closed forms and against independent scipy computations (Brent's
+method on eq. 12, adaptive Runge–Kutta integrations of the Tsuji impact) kept in
+``tests/python/contact_oracles.py``.
 """
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Literal, Optional
+from typing import TYPE_CHECKING, Literal, NamedTuple, Optional
 
 import numpy as np
-from scipy.integrate import solve_ivp
-from scipy.optimize import brentq
 
+from demfem import _core
 from demfem.errors import InvalidParameterError, as_real, check_positive, check_range
 
 if TYPE_CHECKING:
@@ -42,7 +45,6 @@ __all__ = [
     "rayleigh_time_step",
     "tsuji_restitution",
     "tsuji_damping_for_restitution",
-    "damped_hertz_impact",
     "ImpactResult",
 ]
 
@@ -54,43 +56,50 @@ def _check_nu(field: str, nu: float) -> float:
     return check_range(field, nu, -1.0, 0.5)
 
 
+def _check_positive_or_inf(field: str, value: float) -> float:
+    """``value`` as a float if it is > 0 and finite, or +inf; else an error naming ``field``."""
+    x = as_real(field, value)
+    if math.isinf(x) and x > 0:
+        return x
+    return check_positive(field, value)
+
+
 def effective_modulus(E1: float, nu1: float, E2: float, nu2: float) -> float:
-    """E* from 1/E* = (1−ν1²)/E1 + (1−ν2²)/E2 (eq. 4), Pa. ``E2 = inf``: rigid partner."""
+    """E* from 1/E* = (1−ν1²)/E1 + (1−ν2²)/E2 (eq. 4), Pa. ``E2 = inf``: rigid partner.
+
+    Computed by the Rust core (``demfem._core.effective_modulus``)."""
     E1 = check_positive("E1", E1)
     nu1 = _check_nu("nu1", nu1)
     nu2 = _check_nu("nu2", nu2)
-    E2 = float(E2)
-    if math.isinf(E2) and E2 > 0:
-        c2 = 0.0
-    else:
-        c2 = (1.0 - nu2**2) / check_positive("E2", E2)
-    return 1.0 / ((1.0 - nu1**2) / E1 + c2)
+    E2 = _check_positive_or_inf("E2", E2)
+    return _core.effective_modulus(E1, nu1, E2, nu2)
 
 
 def effective_radius(R1: float, R2: float) -> float:
-    """R* from 1/R* = 1/R1 + 1/R2 (eq. 3), m. ``R2 = inf``: a plane."""
+    """R* from 1/R* = 1/R1 + 1/R2 (eq. 3), m. ``R2 = inf``: a plane.
+
+    Computed by the Rust core (``demfem._core.effective_radius``)."""
     R1 = check_positive("R1", R1)
-    R2 = float(R2)
-    if math.isinf(R2) and R2 > 0:
-        return R1
-    return 1.0 / (1.0 / R1 + 1.0 / check_positive("R2", R2))
+    R2 = _check_positive_or_inf("R2", R2)
+    return _core.effective_radius(R1, R2)
 
 
 def effective_mass(m1: float, m2: float) -> float:
-    """m* from 1/m* = 1/m1 + 1/m2 (eq. 9), kg. ``m2 = inf``: an immovable partner."""
+    """m* from 1/m* = 1/m1 + 1/m2 (eq. 9), kg. ``m2 = inf``: an immovable partner.
+
+    Computed by the Rust core (``demfem._core.effective_mass``)."""
     m1 = check_positive("m1", m1)
-    m2 = float(m2)
-    if math.isinf(m2) and m2 > 0:
-        return m1
-    return 1.0 / (1.0 / m1 + 1.0 / check_positive("m2", m2))
+    m2 = _check_positive_or_inf("m2", m2)
+    return _core.effective_mass(m1, m2)
 
 
 def hertz_stiffness(R1: float, R2: float, E1: float, nu1: float, E2: float, nu2: float) -> float:
     """Hertz stiffness k_H = 4/3 √R* E* (eqs. 2–4), N/m^{3/2}; F = k_H d^{3/2} (eq. 1).
 
-    Radii in m (``inf`` for a plane), moduli in Pa (``inf`` for a rigid partner).
+    Radii in m (``inf`` for a plane), moduli in Pa (``inf`` for a rigid partner). Computed by
+    the Rust core (``demfem._core.hertz_stiffness`` of R* and E*).
     """
-    return 4.0 / 3.0 * math.sqrt(effective_radius(R1, R2)) * effective_modulus(E1, nu1, E2, nu2)
+    return _core.hertz_stiffness(effective_radius(R1, R2), effective_modulus(E1, nu1, E2, nu2))
 
 
 def reissner_stiffness(E: float, nu: float, t: float, R: float) -> float:
@@ -99,7 +108,8 @@ def reissner_stiffness(E: float, nu: float, t: float, R: float) -> float:
     k_R = 4 / √(3 (1 − ν²)) · E t² / R,
 
     with E in Pa, wall thickness ``t`` (m) and mid-surface radius of curvature ``R`` (m),
-    0 < t < R; F = k_R d_R (eq. 5).
+    0 < t < R; F = k_R d_R (eq. 5). Computed by the Rust core
+    (``demfem._core.reissner_stiffness``).
     """
     E = check_positive("E", E)
     nu = _check_nu("nu", nu)
@@ -107,7 +117,7 @@ def reissner_stiffness(E: float, nu: float, t: float, R: float) -> float:
     R = check_positive("R", R)
     if t >= R:
         raise InvalidParameterError(f"invalid t = {t!r}: must be < R = {R!r} (a thin shell)")
-    return 4.0 / math.sqrt(3.0 * (1.0 - nu**2)) * E * t**2 / R
+    return _core.reissner_stiffness(E, nu, t, R)
 
 
 @dataclass(frozen=True)
@@ -195,20 +205,32 @@ class ContactBody:
         return reissner_stiffness(self.E, self.nu, self.shell_thickness, self.shell_radius)
 
 
-def _pair(a: ContactBody, b: ContactBody) -> tuple[float, float, float]:
-    """(k_H, k_R of both shells in series, m*) of a pair; ``inf`` entries (a plane, a rigid
+class _Pair(NamedTuple):
+    """The effective quantities of a pair of bodies (eqs. 2–4, 6, 9)."""
+
+    k_h: float  # Hertz stiffness, N/m^{3/2}
+    k_r: float  # Reissner stiffness of both shells in series, N/m (inf: no shell)
+    m_star: float  # effective mass, kg
+    r_star: float  # effective radius, m
+    e_star: float  # effective modulus, Pa
+
+
+def _pair(a: ContactBody, b: ContactBody) -> _Pair:
+    """The effective quantities of a pair, from the core; ``inf`` entries (a plane, a rigid
     or an immovable wall) drop out of the harmonic sums of eqs. 3, 4 and 9."""
     for what, x, y in (("radius", a.radius, b.radius), ("mass", a.mass, b.mass), ("E", a.E, b.E)):
         if math.isinf(x) and math.isinf(y):
             raise InvalidParameterError(
                 f"invalid pair: both bodies have {what} = inf (no finite contact partner)")
-    inv = lambda x: 0.0 if math.isinf(x) else 1.0 / x  # noqa: E731
-    r_star = 1.0 / (inv(a.radius) + inv(b.radius))
-    e_star = 1.0 / ((1.0 - a.nu**2) * inv(a.E) + (1.0 - b.nu**2) * inv(b.E))
-    m_star = 1.0 / (inv(a.mass) + inv(b.mass))
-    k_r = 1.0 / (inv(a.k_reissner) + inv(b.k_reissner)) if (
-        math.isfinite(a.k_reissner) or math.isfinite(b.k_reissner)) else math.inf
-    return 4.0 / 3.0 * math.sqrt(r_star) * e_star, k_r, m_star
+    # the core takes the finite partner first (the second may be inf)
+    r1, r2 = (a, b) if math.isfinite(a.radius) else (b, a)
+    e1, e2 = (a, b) if math.isfinite(a.E) else (b, a)
+    m1, m2 = (a, b) if math.isfinite(a.mass) else (b, a)
+    r_star = _core.effective_radius(r1.radius, r2.radius)
+    e_star = _core.effective_modulus(e1.E, e1.nu, e2.E, e2.nu)
+    m_star = _core.effective_mass(m1.mass, m2.mass)
+    k_r = _core.series_stiffness(a.k_reissner, b.k_reissner)
+    return _Pair(_core.hertz_stiffness(r_star, e_star), k_r, m_star, r_star, e_star)
 
 
 #: Smallest non-zero relative impact speed, m/s: below it m* v_rel^2 can underflow to zero
@@ -229,17 +251,19 @@ def _check_v(v_rel: float, allow_zero: bool = True) -> float:
 def k_linear(a: ContactBody, b: ContactBody, v_rel: float) -> float:
     """Linearised Hertz stiffness (eq. 13), N/m:
     k_lin = 4/3 (15/16)^{1/5} R*^{2/5} E*^{4/5} m*^{1/5} v_rel^{2/5}.
-    It gives the Hertz maximum overlap and a force √(4/5) times the Hertz maximum force."""
+    It is the secant stiffness F/δ at the maximum of a Hertz impact; an impact on a spring of
+    this stiffness reaches √(4/5) times the Hertz maximum force (and overlap).
+    Computed by the Rust core (``demfem._core.linearized_hertz_stiffness``)."""
     v = _check_v(v_rel)
-    k_h, _, m_star = _pair(a, b)
-    # k_H = 4/3 √R* E*  ⇒  R*^{2/5} E*^{4/5} = (3 k_H / 4)^{4/5}
-    return 4.0 / 3.0 * (15.0 / 16.0) ** 0.2 * (0.75 * k_h) ** 0.8 * m_star**0.2 * v**0.4
+    p = _pair(a, b)
+    return _core.linearized_hertz_stiffness(p.r_star, p.e_star, p.m_star, v)
 
 
 def k_eq(a: ContactBody, b: ContactBody, v_rel: float) -> float:
-    """Equivalent stiffness 1/k_eq = 1/k_R1 + 1/k_R2 + 1/k_lin (eq. 15), N/m."""
-    _, k_r, _ = _pair(a, b)
-    return 1.0 / (1.0 / k_r + 1.0 / k_linear(a, b, v_rel))
+    """Equivalent stiffness 1/k_eq = 1/k_R1 + 1/k_R2 + 1/k_lin (eq. 15), N/m.
+    Computed by the Rust core (``demfem._core.series_stiffness``)."""
+    p = _pair(a, b)
+    return _core.series_stiffness(p.k_r, k_linear(a, b, v_rel))
 
 
 def max_contact_force(a: ContactBody, b: ContactBody, v_rel: float, model: Model = "hertz_reissner") -> float:
@@ -247,139 +271,98 @@ def max_contact_force(a: ContactBody, b: ContactBody, v_rel: float, model: Model
 
     ``model``:
 
-    * ``"hertz"`` — shells rigid: m* v² = (4/5) F^{5/3} / k_H^{2/3} (eq. 12 with k_R → ∞);
+    * ``"hertz"`` — shells rigid: m* v² = (4/5) F^{5/3} / k_H^{2/3} (eq. 12 with k_R → ∞),
+      F = k_H^{2/5} (5/4 m* v²)^{3/5};
     * ``"reissner"`` — contact rigid: m* v² = F²/k_R1 + F²/k_R2 (eq. 12 without Hertz);
     * ``"hertz_reissner"`` — both in series: the root of eq. 12,
-      m* v² = F²/k_R1 + F²/k_R2 + (4/5) F^{5/3}/k_H^{2/3}, bracketed in
-      [0, min(F_hertz, F_reissner)] (the left side grows with F and each single law alone
-      reaches m* v² earlier) and solved by Brent's method to machine precision;
+      m* v² = F²/k_R1 + F²/k_R2 + (4/5) F^{5/3}/k_H^{2/3}, found by the core by Newton's
+      method in x = F^{1/3} from above, starting at min(F_hertz, F_reissner)^{1/3} (each law
+      alone reaches m* v² at a smaller x, and the right side is convex and increasing in x),
+      to round-off; without a shell it is the Hertz force;
     * ``"linearized"`` — F = √(k_eq m*) v (eqs. 13–15).
+
+    Computed by the Rust core (``demfem._core.max_impact_force``).
     """
     v = _check_v(v_rel)
     if model not in MODELS:
         raise InvalidParameterError(f"invalid model = {model!r}: must be one of {MODELS}")
-    k_h, k_r, m_star = _pair(a, b)
+    p = _pair(a, b)
     if v == 0.0:
         return 0.0
-    w = m_star * v * v
-    f_hertz = k_h**0.4 * (1.25 * w) ** 0.6
-    f_reissner = math.sqrt(k_r * w) if math.isfinite(k_r) else math.inf
     if model == "hertz":
-        return f_hertz
+        return _core.max_impact_force(p.m_star, v, "hertz", k_h=p.k_h)
     if model == "reissner":
-        if not math.isfinite(k_r):
+        if not math.isfinite(p.k_r):
             raise InvalidParameterError("invalid model = 'reissner': neither body has a shell")
-        return f_reissner
+        return _core.max_impact_force(p.m_star, v, "linear", k=p.k_r)
     if model == "linearized":
-        return math.sqrt(k_eq(a, b, v) * m_star) * v
-    hi = min(f_hertz, f_reissner)
-    kh23 = k_h ** (2.0 / 3.0)
-
-    def residual(x: float) -> float:  # scaled by m* v² so it is O(1) for any E, v
-        f = x * hi
-        return (f * f / k_r + 0.8 * f ** (5.0 / 3.0) / kh23) / w - 1.0
-
-    if residual(1.0) <= 0.0:  # only when one law is absent or round-off at the bracket end
-        return hi
-    x = brentq(residual, 0.0, 1.0, xtol=1e-300, rtol=4.0 * np.finfo(float).eps, maxiter=500)
-    return float(x * hi)
+        return _core.max_impact_force(p.m_star, v, "linear", k=k_eq(a, b, v))
+    if not math.isfinite(p.k_r):  # no shell: eq. 12 is Hertz alone
+        return _core.max_impact_force(p.m_star, v, "hertz", k_h=p.k_h)
+    return _core.max_impact_force(p.m_star, v, "hertz_reissner", k_h=p.k_h, k_r=p.k_r)
 
 
 def normal_force(overlap: np.ndarray, model: Literal["hertz", "linear", "hertz_reissner"],
                  k_h: float = math.nan, k_r: float = math.nan, k: float = math.nan) -> np.ndarray:
-    """Elastic normal force (N) at each overlap (m); zero where overlap <= 0.
+    """Elastic normal force (N) at each overlap (m), in the shape of ``overlap``; zero where
+    overlap <= 0.
 
     * ``"hertz"``: F = k_H d^{3/2} (eq. 1), ``k_h`` in N/m^{3/2};
     * ``"linear"``: F = k d, ``k`` in N/m (eq. 5 for a shell, eq. 15 linearised);
-    * ``"hertz_reissner"``: d = (F/k_H)^{2/3} + F/k_R, the series law behind eq. 12, solved
-      per entry by Brent's method on the bracket [0, min(k_H d^{3/2}, k_R d)].
+    * ``"hertz_reissner"``: d = (F/k_H)^{2/3} + F/k_R, the series law behind eq. 12 (``k_r``
+      in N/m), solved by the core in normalised form (u³ + u² = s, see docs/method.md).
+
+    Computed by the Rust core (``demfem._core.normal_force``, which the DEM uses).
     """
     d = np.asarray(overlap, dtype=float)
     if not np.all(np.isfinite(d)):
         raise InvalidParameterError("invalid overlap: must be finite (NaN or inf given)")
-    out = np.zeros_like(d)
-    pos = d > 0
     if model == "hertz":
-        out[pos] = check_positive("k_h", k_h) * d[pos] ** 1.5
+        kw = {"k_h": check_positive("k_h", k_h)}
     elif model == "linear":
-        out[pos] = check_positive("k", k) * d[pos]
+        kw = {"k": check_positive("k", k)}
     elif model == "hertz_reissner":
-        k_h = check_positive("k_h", k_h)
-        k_r = check_positive("k_r", k_r)
-        flat = out.reshape(-1)
-        for i, di in enumerate(d.reshape(-1)):
-            if di <= 0:
-                continue
-            hi = min(k_h * di**1.5, k_r * di)
-            g = lambda x, di=di, hi=hi: ((x * hi / k_h) ** (2.0 / 3.0) + x * hi / k_r) / di - 1.0  # noqa: E731
-            flat[i] = hi * brentq(g, 0.0, 1.0, xtol=1e-300, rtol=4.0 * np.finfo(float).eps,
-                                  maxiter=500)
-        out = flat.reshape(d.shape)
+        kw = {"k_h": check_positive("k_h", k_h), "k_r": check_positive("k_r", k_r)}
     else:
         raise InvalidParameterError(
             f"invalid model = {model!r}: must be one of ('hertz', 'linear', 'hertz_reissner')")
-    return out
+    f, _ = _core.normal_force(np.ascontiguousarray(d.reshape(-1)), model, **kw)
+    return f.reshape(d.shape)
 
 
 def hertz_max_overlap(a: ContactBody, b: ContactBody, v_rel: float) -> float:
-    """Maximum overlap of an undamped Hertz impact, (5 m* v² / (4 k_H))^{2/5}, m."""
-    k_h, _, m_star = _pair(a, b)
+    """Maximum overlap of an undamped Hertz impact, (5 m* v² / (4 k_H))^{2/5}, m.
+    Computed by the Rust core (``demfem._core.hertz_max_overlap``)."""
+    p = _pair(a, b)
     v = _check_v(v_rel)
-    return (1.25 * m_star * v * v / k_h) ** 0.4
+    return _core.hertz_max_overlap(p.k_h, p.m_star, v)
 
 
 def hertz_contact_duration(a: ContactBody, b: ContactBody, v_rel: float) -> float:
     """Duration of an undamped Hertz impact, s:
-    t_c = 2 (δ_max / v) ∫₀¹ (1 − x^{5/2})^{-1/2} dx = 2.9432… δ_max / v (Johnson §11.4)."""
+    t_c = 2 (δ_max / v) ∫₀¹ (1 − x^{5/2})^{-1/2} dx = 2.9432… δ_max / v (Johnson §11.4).
+    Computed by the Rust core (``demfem._core.hertz_impact_duration``)."""
     v = _check_v(v_rel, allow_zero=False)
-    from scipy.special import beta
-
-    factor = 2.0 * 0.4 * beta(0.4, 0.5)
-    return factor * hertz_max_overlap(a, b, v) / v
+    p = _pair(a, b)
+    return _core.hertz_impact_duration(p.k_h, p.m_star, v)
 
 
 def rayleigh_time_step(radius: float, E: float, nu: float, density: float) -> float:
     """Rayleigh time step π R √(ρ/G) / (0.1631 ν + 0.8766), s, of a sphere of ``radius`` (m),
-    Young's modulus ``E`` (Pa), Poisson's ratio ``nu`` and ``density`` (kg/m³)."""
+    Young's modulus ``E`` (Pa), Poisson's ratio ``nu`` and ``density`` (kg/m³), with
+    G = E / (2 (1 + ν)). Computed by the Rust core (``demfem._core.rayleigh_time_step``),
+    which refuses, naming ``E``, a modulus so small (subnormal) that G underflows to 0."""
     R = check_positive("radius", radius)
     E = check_positive("E", E)
     nu = _check_nu("nu", nu)
     rho = check_positive("density", density)
-    G = E / (2.0 * (1.0 + nu))
-    dt = math.pi * R * math.sqrt(rho / G) / (0.1631 * nu + 0.8766) if G > 0 else math.inf
-    if not (G > 0 and math.isfinite(dt) and dt > 0):
-        # a subnormal E underflows G to 0 (rho / G divided by zero)
-        raise InvalidParameterError(
-            f"invalid E = {E!r}: must be large enough that G = E/(2(1+nu)) > 0 and the step "
-            "pi R sqrt(rho/G)/(0.1631 nu + 0.8766) is finite and > 0")
-    return dt
+    return _core.rayleigh_time_step(R, E, nu, rho)
 
 
 # ---------------------------------------------------------------------------- restitution
-#: Largest Tsuji ζ that :func:`tsuji_restitution` integrates (as the core's
-#: ``MAX_TSUJI_ZETA``); beyond it the overdamped limit e = 1.25/ζ² (clamped) or 0 is returned
-#: (the core's fixed-step integration returned -1 at ζ = 1e20).
+#: Largest Tsuji ζ that the core integrates (its ``MAX_TSUJI_ZETA``); beyond it
+#: :func:`tsuji_restitution` returns the overdamped limit e = 1.25/ζ² (clamped) or 0.
 MAX_TSUJI_ZETA = 1e3
-
-
-def _tsuji_rhs(zeta: float, clamp: bool):
-    def rhs(_t: float, y: np.ndarray) -> list[float]:
-        x, v = max(y[0], 0.0), y[1]
-        f = x**1.5 + zeta * x**0.25 * v
-        if clamp:
-            f = max(f, 0.0)
-        return [v, -f]
-
-    return rhs
-
-
-def _overlap_exit(_t: float, y: np.ndarray) -> float:
-    """solve_ivp event: the overlap y[0] returns to zero (the bodies separate)."""
-    return y[0]
-
-
-_overlap_exit.terminal = True  # type: ignore[attr-defined]
-_overlap_exit.direction = -1  # type: ignore[attr-defined]
 
 
 def tsuji_restitution(zeta: float, clamp: bool = False) -> float:
@@ -391,92 +374,33 @@ def tsuji_restitution(zeta: float, clamp: bool = False) -> float:
     equation of motion into X'' = −X^{3/2} − ζ X^{1/4} X', so e depends on ζ only. With
     ``clamp=True`` the total force is clamped at ≥ 0 (no attraction near separation), and
     the bodies separate when it vanishes: the realised restitution is then higher.
-    Integrated here with an adaptive Runge–Kutta method (DOP853, rtol 1e-12).
+
+    Computed by the Rust core (``demfem._core.tsuji_restitution``): classical RK4 with a step
+    that shrinks where X^{1/4} is not smooth (within about 3e-11 of an adaptive DOP853
+    integration unclamped, 3e-9 clamped); beyond ζ = :data:`MAX_TSUJI_ZETA` the overdamped
+    limit 1.25/ζ² (clamped) or 0 (unclamped).
     """
     zeta = check_range("zeta", zeta, 0.0, math.inf, lo_open=False)
-    if zeta > MAX_TSUJI_ZETA:
-        # overdamped limit (as the core): clamped, e = X_m^{5/4}/zeta with
-        # X_m = (5/(4 zeta))^{4/5}, i.e. 1.25/zeta^2; unclamped, the bodies stay together
-        return 1.25 / (zeta * zeta) if clamp else 0.0
-    rhs = _tsuji_rhs(zeta, clamp)
-
-    events = [_overlap_exit]
-    if clamp:
-        def zero_force(_t: float, y: np.ndarray) -> float:
-            x = max(y[0], 0.0)
-            return x**1.5 + zeta * x**0.25 * y[1] if y[1] < 0 else 1.0
-
-        zero_force.terminal = True  # type: ignore[attr-defined]
-        zero_force.direction = -1  # type: ignore[attr-defined]
-        events.append(zero_force)
-    sol = solve_ivp(rhs, (0.0, 1e3), [0.0, 1.0], method="DOP853", rtol=1e-12, atol=1e-14,
-                    events=events, max_step=0.05)
-    for ev in sol.y_events:
-        if len(ev):
-            return float(max(-ev[0][1], 0.0))
-    return 0.0  # the overlap never returned to zero: fully damped
+    return _core.tsuji_restitution(zeta, bool(clamp))
 
 
 def tsuji_damping_for_restitution(e: float, clamp: bool = False) -> float:
     """Tsuji damping parameter ζ (dimensionless) that realises restitution ``e`` in (0, 1].
 
-    Found by Brent's method on :func:`tsuji_restitution`, which decreases with ζ."""
+    Computed by the Rust core (``demfem._core.tsuji_damping_for_restitution``): bisection on
+    its :func:`tsuji_restitution`, which decreases with ζ, to 1e-13 relative in ζ."""
     e = check_range("restitution", e, 0.0, 1.0, hi_open=False)
-    if e == 1.0:
-        return 0.0
-    hi = 1.0
-    while tsuji_restitution(hi, clamp) > e:
-        hi *= 2.0
-        if hi > 1e6:
-            raise InvalidParameterError(f"invalid restitution = {e!r}: not reachable")
-    return float(brentq(lambda z: tsuji_restitution(z, clamp) - e, 0.0, hi, xtol=1e-12))
+    return _core.tsuji_damping_for_restitution(e, bool(clamp))
 
 
 @dataclass(frozen=True)
 class ImpactResult:
     """One integrated normal impact: time (s), overlap (m), normal force (N) histories,
-    the realised restitution and the maximum force (N)."""
+    the realised restitution and the maximum force (N). (The integration itself, a scipy
+    reference for the tests, lives in ``tests/python/contact_oracles.py``.)"""
 
     time: np.ndarray
     overlap: np.ndarray
     force: np.ndarray
     restitution: float
     max_force: float
-
-
-def damped_hertz_impact(a: ContactBody, b: ContactBody, v_rel: float, restitution: float = 1.0,
-                        clamp: bool = False, n_out: int = 400) -> ImpactResult:
-    """Integrate one head-on Hertz impact (dimensional units) with Tsuji damping chosen for
-    ``restitution``; ``v_rel`` in m/s. Returns the histories and the realised restitution."""
-    v = _check_v(v_rel, allow_zero=False)
-    k_h, _, m_star = _pair(a, b)
-    zeta = tsuji_damping_for_restitution(restitution, clamp)
-    c = zeta * math.sqrt(m_star * k_h)
-
-    def force(x: float, xd: float) -> float:
-        x = max(x, 0.0)
-        f = k_h * x**1.5 + c * x**0.25 * xd
-        return max(f, 0.0) if clamp else f
-
-    def rhs(_t: float, y: np.ndarray) -> list[float]:
-        return [y[1], -force(y[0], y[1]) / m_star]
-
-    events = [_overlap_exit]
-    if clamp:
-        def unload(_t: float, y: np.ndarray) -> float:
-            return force(y[0], y[1]) if y[1] < 0 else 1.0
-
-        unload.terminal = True  # type: ignore[attr-defined]
-        unload.direction = -1  # type: ignore[attr-defined]
-        events.append(unload)
-    tc = 2.9432751790197716 * (1.25 * m_star * v * v / k_h) ** 0.4 / v
-    sol = solve_ivp(rhs, (0.0, 50 * tc), [0.0, v], method="DOP853", rtol=1e-11,
-                    atol=1e-16 * max(1.0, v), events=events, dense_output=True,
-                    max_step=tc / 200)
-    t_end = sol.t[-1]
-    ts = np.linspace(0.0, t_end, n_out)
-    ys = sol.sol(ts)
-    forces = np.array([force(x, xd) for x, xd in ys.T])
-    v_out = -sol.y[1, -1]
-    return ImpactResult(time=ts, overlap=ys[0], force=forces, restitution=float(v_out / v),
-                        max_force=float(forces.max()))

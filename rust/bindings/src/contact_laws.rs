@@ -1,6 +1,9 @@
 //! Python binding of the contact laws written once in the core ([`demfem::contact`]): the
-//! normal force of a law at given overlaps, the impact force and duration of a pair, Tsuji
-//! restitution and the Rayleigh time step. SI units (m, N, kg, s, Pa).
+//! effective quantities of a pair (eqs. 3, 4, 9), the Hertz, Reissner, series and linearised
+//! stiffnesses (eqs. 2, 6, 13, 15), the normal force of a law at given overlaps, the impact
+//! force, overlap and duration of a pair, Tsuji restitution and the Rayleigh time step.
+//! `demfem.contact` validates its inputs by name and computes through these functions; it
+//! holds no second implementation. SI units (m, N, kg, s, Pa).
 
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
@@ -147,6 +150,89 @@ fn hertz_impact_duration(k_h: f64, m_star: f64, v_rel: f64) -> PyResult<f64> {
     Ok(contact::hertz_contact_duration(k_h, m_star, v_rel).map_err(PyDemfemError::from)?)
 }
 
+/// `value` > 0 or +inf (a plane, a rigid or an immovable partner); NaN refused; names `field`.
+fn check_positive_or_inf(field: &str, value: f64, what: &str) -> CoreResult<f64> {
+    if value > 0.0 {
+        Ok(value)
+    } else {
+        Err(DemfemError::invalid(field, value, &format!("> 0 (inf for {what})")).into())
+    }
+}
+
+/// Effective modulus E* (Pa) from 1/E* = (1−ν1²)/E1 + (1−ν2²)/E2 (eq. 4); `E2 = inf` is a
+/// rigid partner.
+#[pyfunction]
+#[allow(non_snake_case)]
+#[pyo3(signature = (E1, nu1, E2, nu2))]
+fn effective_modulus(E1: f64, nu1: f64, E2: f64, nu2: f64) -> PyResult<f64> {
+    Ok(contact::effective_modulus(E1, nu1, E2, nu2).map_err(PyDemfemError::from)?)
+}
+
+/// Effective radius R* (m) from 1/R* = 1/R1 + 1/R2 (eq. 3); `R2 = inf` is a plane.
+#[pyfunction]
+#[allow(non_snake_case)]
+#[pyo3(signature = (R1, R2))]
+fn effective_radius(R1: f64, R2: f64) -> PyResult<f64> {
+    Ok(contact::effective_radius(R1, R2).map_err(PyDemfemError::from)?)
+}
+
+/// Effective mass m* (kg) from 1/m* = 1/m1 + 1/m2 (eq. 9); `m2 = inf` is an immovable
+/// partner.
+#[pyfunction]
+fn effective_mass(m1: f64, m2: f64) -> PyResult<f64> {
+    Ok(contact::effective_mass(m1, m2).map_err(PyDemfemError::from)?)
+}
+
+/// Hertz stiffness k_H = 4/3 √R* E* (eq. 2), N/m^1.5, of a pair of effective radius R_star
+/// (m) and effective modulus E_star (Pa).
+#[pyfunction]
+#[allow(non_snake_case)]
+#[pyo3(signature = (R_star, E_star))]
+fn hertz_stiffness(R_star: f64, E_star: f64) -> PyResult<f64> {
+    Ok(contact::hertz_stiffness(R_star, E_star).map_err(PyDemfemError::from)?)
+}
+
+/// Reissner point-load stiffness of a thin shallow shell (eq. 6), N/m: E (Pa), nu, wall
+/// thickness t (m) and mid-surface radius R (m), 0 < t < R.
+#[pyfunction]
+#[allow(non_snake_case)]
+#[pyo3(signature = (E, nu, t, R))]
+fn reissner_stiffness(E: f64, nu: f64, t: f64, R: f64) -> PyResult<f64> {
+    Ok(contact::reissner_stiffness(E, nu, t, R).map_err(PyDemfemError::from)?)
+}
+
+/// Two springs in series, 1/k = 1/k1 + 1/k2 (eqs. 12 and 15), N/m; `inf` is a spring that
+/// does not deflect (a wall, a solid body), and two of them give `inf`.
+#[pyfunction]
+fn series_stiffness(k1: f64, k2: f64) -> PyResult<f64> {
+    check_positive_or_inf("k1", k1, "a rigid spring")?;
+    check_positive_or_inf("k2", k2, "a rigid spring")?;
+    Ok(contact::series(k1, k2))
+}
+
+/// Linearised Hertz stiffness (eq. 13), N/m:
+/// k_lin = 4/3 (15/16)^{1/5} R*^{2/5} E*^{4/5} m*^{1/5} v_rel^{2/5}.
+#[pyfunction]
+#[allow(non_snake_case)]
+#[pyo3(signature = (R_star, E_star, m_star, v_rel))]
+fn linearized_hertz_stiffness(R_star: f64, E_star: f64, m_star: f64, v_rel: f64) -> PyResult<f64> {
+    demfem::error::check_positive("R_star", R_star).map_err(PyDemfemError::from)?;
+    demfem::error::check_positive("E_star", E_star).map_err(PyDemfemError::from)?;
+    contact_checks(m_star, v_rel)?;
+    Ok(contact::linearized_hertz_stiffness(
+        R_star, E_star, m_star, v_rel,
+    ))
+}
+
+/// Maximum overlap (m) of an undamped Hertz impact of stiffness k_h (N/m^1.5) and effective
+/// mass m_star (kg) at v_rel (m/s): (5 m* v² / (4 k_H))^{2/5}.
+#[pyfunction]
+fn hertz_max_overlap(k_h: f64, m_star: f64, v_rel: f64) -> PyResult<f64> {
+    demfem::error::check_positive("k_h", k_h).map_err(PyDemfemError::from)?;
+    contact_checks(m_star, v_rel)?;
+    Ok(contact::hertz_max_overlap(k_h, m_star, v_rel))
+}
+
 /// Register the contact-law functions on the extension module.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(normal_force, m)?)?;
@@ -155,5 +241,13 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(tsuji_damping_for_restitution, m)?)?;
     m.add_function(wrap_pyfunction!(rayleigh_time_step, m)?)?;
     m.add_function(wrap_pyfunction!(hertz_impact_duration, m)?)?;
+    m.add_function(wrap_pyfunction!(effective_modulus, m)?)?;
+    m.add_function(wrap_pyfunction!(effective_radius, m)?)?;
+    m.add_function(wrap_pyfunction!(effective_mass, m)?)?;
+    m.add_function(wrap_pyfunction!(hertz_stiffness, m)?)?;
+    m.add_function(wrap_pyfunction!(reissner_stiffness, m)?)?;
+    m.add_function(wrap_pyfunction!(series_stiffness, m)?)?;
+    m.add_function(wrap_pyfunction!(linearized_hertz_stiffness, m)?)?;
+    m.add_function(wrap_pyfunction!(hertz_max_overlap, m)?)?;
     Ok(())
 }
