@@ -334,12 +334,14 @@ def test_huge_tsuji_zeta_gives_the_overdamped_restitution():
 
     # the core's fixed-step integration returned -1 at zeta = 1e20: beyond 1e3 the
     # overdamped limit 1.25/zeta^2 (clamped) or 0 is returned, by both implementations
-    assert _core.tsuji_restitution(1e20, True) == pytest.approx(1.25e-40, rel=1e-12)
+    import contact_oracles as oracle
+
     assert contact.tsuji_restitution(1e20, True) == pytest.approx(1.25e-40, rel=1e-12)
-    assert _core.tsuji_restitution(1e20, False) == 0.0
-    e = _core.tsuji_restitution(1e3, True)
-    assert e == pytest.approx(contact.tsuji_restitution(1e3, True), rel=1e-6)
-    assert e == pytest.approx(1.25e-6, rel=1e-4)  # the limit joins the integration
+    assert contact.tsuji_restitution(1e20, False) == 0.0
+    e = contact.tsuji_restitution(1e3, True)
+    # the limit joins the integration: against the independent adaptive (DOP853) integration
+    assert e == pytest.approx(oracle.tsuji_restitution(1e3, True), rel=1e-6)
+    assert e == pytest.approx(1.25e-6, rel=1e-4)
     with pytest.raises(InvalidParameterError, match="invalid zeta"):
         _core.tsuji_restitution(-1.0, True)
 
@@ -351,8 +353,13 @@ def test_extreme_reissner_stiffness_ratio_gives_a_finite_force():
     for k_h, k_r in [(1.0, 1e-300), (1e-300, 1e300), (1e300, 1e-300), (1e10, 1e6)]:
         f, kt = _core.normal_force(d, "hertz_reissner", k_h=k_h, k_r=k_r, k=1.0)
         assert np.isfinite(f).all() and np.isfinite(kt).all() and (f > 0).all()
-        assert f == pytest.approx(contact.normal_force(d, "hertz_reissner", k_h=k_h, k_r=k_r),
-                                  rel=1e-9)
+        if k_h * k_r > 0 and 1e-200 < k_h < 1e200 and 1e-200 < k_r < 1e200:
+            # against Brent's method on the series law (independent of the core)
+            import contact_oracles as oracle
+            assert f == pytest.approx(oracle.hertz_reissner_force(d, k_h, k_r), rel=1e-9)
+        else:      # a law so lopsided that the softer spring alone carries the force
+            soft = np.minimum(k_h * d**1.5, k_r * d)
+            assert f == pytest.approx(soft, rel=1e-9)
         assert f[1] > f[0]
     with pytest.raises(InvalidParameterError, match="k_R"):
         _core.normal_force(d, "hertz_reissner", k_h=1.0, k_r=0.0, k=1.0)
