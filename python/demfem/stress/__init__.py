@@ -5,7 +5,8 @@ N, arrays allowed) of a given geometry — two cartridges crossed at an angle, s
 cartridge against a flat wall or a rail edge — the peak max-principal stress σ1 (Pa) on the
 outer and inner glass surface and the Weibull effective area (m²) of each, as the
 superposition of the local contact field (Hertz, Hamilton's sliding contact) and the wall's
-bending (Reissner's shallow shell, the ring). See ``docs/stress.md``.
+bending (the cylindrical shell with the load's spread through the wall). See
+``docs/stress.md``.
 
 Modules, one concept each:
 
@@ -13,8 +14,12 @@ Modules, one concept each:
   subsurface stresses;
 * :mod:`~demfem.stress.hamilton` — the sliding contact's tangential traction (Hamilton 1983);
 * :mod:`~demfem.stress.surface_field` — the surface field of an elliptical sliding contact;
-* :mod:`~demfem.stress.shell` — Reissner's shallow shell under a point or Hertzian load;
-* :mod:`~demfem.stress.ring` — the tube as a ring under line loads (Roark);
+* :mod:`~demfem.stress.cylinder_load` — the wall as a cylindrical shell under a local radial
+  load (point or line contact), with the thick-plate correction: the global field;
+* :mod:`~demfem.stress.shell` — Reissner's shallow shell under a point or Hertzian load (the
+  shell-only :class:`StressModel`'s);
+* :mod:`~demfem.stress.ring` — the tube as a ring under line loads (Roark; the long line
+  contact's limit, the curved-bar factors);
 * :mod:`~demfem.stress.effective_area` — dimensionless effective-area tables;
 * :mod:`~demfem.stress.flaw_depth` — the stress-gradient (flaw-depth) correction;
 * :mod:`~demfem.stress.model` — the superposition, :func:`contact_stresses`;

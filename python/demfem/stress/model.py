@@ -10,28 +10,31 @@ surface's field, and the terms they are made of. The model superposes, for each 
   effective friction coefficient μ = Q/F (Hamilton 1983, :mod:`demfem.stress.hamilton`;
   elliptical contacts :mod:`demfem.stress.surface_field`): the contact-edge tension
   p0 [(1 − 2ν)/3 + (4 + ν)πμ/8] for a circular contact, 2 μ p0 for a line contact;
-* the **global field** of the wall: the shallow-shell solution under the Hertzian load
-  (Reissner; :func:`demfem.stress.shell.hertz_patch_surface_stresses`) for point contacts,
-  the ring under line loads (:mod:`demfem.stress.ring`) for line contacts. Under the load it
+* the **global field** of the wall: the body as a long cylindrical shell under the contact's
+  radial load (:mod:`demfem.stress.cylinder_load`: the double Fourier series of the load,
+  each harmonic in Sanders–Koiter theory, with the exact elastic-layer correction of the
+  load's spread through the wall) — the Hertz circle (an ellipse as its equivalent circle
+  √(ab)) on the free body held by its d'Alembert force for point contacts, a line load held
+  by an equal one opposite (or by the d'Alembert force) for line contacts. Under the load it
   bends the wall inward: the inner surface in tension, the outer in compression.
 
 Outer σ1: the contact-edge tension plus the bending stress at the same place and in the same
-direction — radial at the edge of the (equivalent circular) contact, r = √(ab), corrected to
-the distance of the peak for an elliptical contact; hoop at the load line for a line contact —
-which is compressive, so the superposition lowers the contact's peak; or, if larger, the
-bending field's own tension away from the contact (the shell's tensile ring at a few ℓ; the
-ring's sides for a line contact). Inner σ1: the bending tension under the load. Effective
-areas (ASTM C1683) of each term from the dimensionless tables of
-:mod:`demfem.stress.effective_area`, combined as A = Σ A_k (σ_k/σ1_max)^m.
+direction — radial at the edge of the contact (r = a for a circle, the distance of the peak for
+an ellipse), the less compressive of along and around the axis (where the frictionless peak
+stands; the worse sliding direction); hoop at the load line for a line contact — which is
+compressive, so the superposition lowers the contact's peak; or, if larger, the bending field's
+own tension away from the contact (the tube's sides). Inner σ1: the bending tension under the
+load. Effective areas (ASTM C1683) of each term from the dimensionless tables of
+:mod:`demfem.stress.effective_area` and :mod:`demfem.stress.cylinder_load`, combined as
+A = Σ A_k (σ_k/σ1_max)^m.
 
 Assumptions and range (docs/stress.md has the discussion): linear elastic glass, quasi-static
-(the contact lasts 30–100 µs, the shell's local bending period under the load ≈ 5 µs), the
+(the contact lasts 30–100 µs, the wall's local bending period under the load ≈ 5 µs), the
 contact small against the wall (a < t for the half-space field, a < ℓ for the concentrated
-shell load), the cylindrical body idealised as a shallow sphere of its mid-surface radius for
-point loads (as the calibration's Reissner stiffness), an elliptical contact's bending field
-that of its equivalent circle √(ab), full sliding (no stick zone), mid-body (``location =
-"body"``: no closed form holds near the open rim or on the shoulder). Optional flaw-depth
-correction (:mod:`demfem.stress.flaw_depth`).
+load), a long straight tube free over the cartridge's body length (no rim, shoulder or free
+ends), full sliding (no stick zone), mid-body (``location = "body"``: no closed form holds near
+the open rim or on the shoulder). Optional flaw-depth correction
+(:mod:`demfem.stress.flaw_depth`).
 
 SI units: N, m, Pa, m².
 """
@@ -49,7 +52,8 @@ from demfem.stress.flaw_depth import circle_flaw_table, flaw_factor, line_flaw_t
 from demfem.stress.hamilton import trailing_edge_tension
 from demfem.stress.hertz import (contact_modulus, crossed_cylinder_curvatures,
                                  ellipse_size_factors, line_contact)
-from demfem.stress.ring import RING_SUPPORTS, ring_stress_profile
+from demfem.stress.cylinder_load import RHO, line_load_profile, point_load_table
+from demfem.stress.ring import RING_SUPPORTS
 from demfem.stress.shell import characteristic_length
 
 __all__ = ["GEOMETRIES", "LOCATIONS", "ContactStresses", "contact_stresses"]
@@ -199,9 +203,9 @@ def contact_stresses(normal_force: Any, tangential_force: Any = 0.0, *,
         partner_material: the other body's material (default: the same glass).
         sliding_direction: for an elliptical contact, the axis the traction runs along:
             ``"major"``, ``"minor"`` or ``"worst"`` (the larger peak; default).
-        ring_support: line contacts: how the ring is held, ``"opposite"`` (an equal load on the
-            other side, diametral compression; default) or ``"inertia"`` (an impact, the ring's
-            d'Alembert force).
+        ring_support: line contacts: how the tube is held, ``"opposite"`` (an equal line load
+            on the other side; default) or ``"inertia"`` (an impact, the d'Alembert force of
+            the free body).
         flaw_depth: depth c_f of the surface flaws, m (scalar or per event), for the
             stress-gradient correction of the contact-edge tension (:mod:`demfem.stress.
             flaw_depth`); None (default): the surface value, no correction.
@@ -269,7 +273,7 @@ def contact_stresses(normal_force: Any, tangential_force: Any = 0.0, *,
                                         "and > 0 m (or None: no correction)")
     e_star = contact_modulus(mat.E, nu, partner.E, partner.nu)
     common = dict(f=f, mu=mu, nu=nu, t=t, ell=ell, m_out=m_out, m_in=m_in, mu_cap=mu_cap,
-                  depth=depth)
+                  depth=depth, r_mid=r_mid, free_length=cart.body_length)
     if geometry in ("crossed", "edge"):
         if contact_length is not None:
             raise InvalidParameterError(f"invalid contact_length = {contact_length!r}: only for "
@@ -297,7 +301,7 @@ def contact_stresses(normal_force: Any, tangential_force: Any = 0.0, *,
         length = check_range("contact_length", contact_length, 0.0, cart.body_length,
                              hi_open=False)
         r_star = 0.5 * r_out if geometry == "parallel" else r_out
-        out = _line(length, r_star, e_star, r_mid, ring_support, **common)
+        out = _line(length, r_star, e_star, ring_support, **common)
     return ContactStresses(**out, friction=mu, weibull_modulus_outer=m_out,
                            weibull_modulus_inner=m_in)
 
@@ -321,8 +325,9 @@ def _offset(contact: np.ndarray, bending: np.ndarray) -> np.ndarray:
 
 def _point(A: float, B: float, e_star: float, *, f: np.ndarray, mu: np.ndarray, nu: float,
            t: float, ell: float, m_out: float, m_in: float, mu_cap: float, depth: Any,
-           direction: str) -> dict[str, np.ndarray]:
-    """Crossed cylinders: elliptical (or circular) Hertz contact on the shallow shell."""
+           r_mid: float, free_length: float, direction: str) -> dict[str, np.ndarray]:
+    """Crossed cylinders: elliptical (or circular) Hertz contact on the cylindrical wall (its
+    field tabulated over c/t, c = √(ab), free over ``free_length``)."""
     alpha, beta, _ = ellipse_size_factors(A, B)
     a = alpha * np.cbrt(f / e_star)
     if np.any(a >= ell):
@@ -336,10 +341,11 @@ def _point(A: float, B: float, e_star: float, *, f: np.ndarray, mu: np.ndarray, 
     b = beta * a
     p0 = 3.0 * f / (2.0 * math.pi * a * b)
     c = np.sqrt(a * b)
-    x_c = c / ell
-    shell = ea.shell_table(nu, m_in, m_out)
-    inner = ea.interp_log(x_c, ea.SHELL_XC, shell["inner_peak"]) * f / t**2
-    inner_area = ea.interp_log(x_c, ea.SHELL_XC, shell["inner_area"]) * math.pi * c * c
+    u = c / t
+    wall = point_load_table(r_mid, t, nu, free_length, m_in, m_out)
+    grid = wall["c_over_t"]
+    inner = np.interp(u, grid, wall["inner_peak"]) * f / t**2
+    inner_area = np.interp(u, grid, wall["inner_area"]) * t * t
     table = ea.contact_table(beta, nu, m_out, mu_cap, direction)
     if beta == 1.0:
         peak = trailing_edge_tension(nu, mu)
@@ -354,12 +360,12 @@ def _point(A: float, B: float, e_star: float, *, f: np.ndarray, mu: np.ndarray, 
         g = flaw_factor(circle_flaw_table(nu, tuple(mus)), mus, trailing_edge_tension(nu, mu),
                         depth / (a if beta == 1.0 else c), mu)
         contact = contact * g
-    bending = _edge_bending(shell, x_c, radius, nu) * f / t**2
+    bending = _edge_bending(wall, u, radius) * f / t**2
     tau = _offset(contact, bending)
     near = contact + bending
     area_near = np.where(near > 0, a * b * ea.interp_mu_tau(table, mu, tau), 0.0)
-    ring = ea.interp_log(x_c, ea.SHELL_XC, shell["ring_peak"]) * f / t**2
-    area_ring = ea.interp_log(x_c, ea.SHELL_XC, shell["ring_area"]) * ell * ell
+    ring = np.interp(u, grid, wall["ring_peak"]) * f / t**2
+    area_ring = np.interp(u, grid, wall["ring_area"]) * t * t
     outer, outer_area = _combine(near, area_near, ring, area_ring, m_out)
     return {"outer_sigma1_max": outer, "inner_sigma1_max": inner,
             "outer_effective_area": outer_area, "inner_effective_area": inner_area,
@@ -367,22 +373,28 @@ def _point(A: float, B: float, e_star: float, *, f: np.ndarray, mu: np.ndarray, 
             "outer_ring_Pa": ring, "outer_from_contact": near >= ring, "p0": p0, "a": a, "b": b}
 
 
-def _edge_bending(shell: dict[str, np.ndarray], x_c: np.ndarray, radius: np.ndarray,
-                  nu: float) -> np.ndarray:
-    """Outer radial bending stress σ t²/F at distance ``radius`` × c from the load centre:
-    the tabulated value at the edge r = c, moved to r = ρ c by the near field of the plate
-    (thin-plate moments outside the Hertz patch): + 6[(1+ν) ln ρ/(4π) + (1−ν)(1 − 1/ρ²)/(20π)]
-    (for ρ < 1, inside the patch, the edge value is kept: the minor-axis end of an ellipse)."""
-    edge = ea.interp_log(x_c, ea.SHELL_XC, shell["edge_outer_r"])
-    rho = np.maximum(radius, 1.0)
-    return edge + 6.0 * ((1.0 + nu) * np.log(rho) / (4.0 * math.pi)
-                         + (1.0 - nu) * (1.0 - 1.0 / rho**2) / (20.0 * math.pi))
+def _edge_bending(wall: dict[str, np.ndarray], u: np.ndarray, radius: np.ndarray) -> np.ndarray:
+    """Outer bending stress σ t²/F at the contact-edge peak, at ``radius`` × c from the load's
+    centre (1 for a circle; below 1, inside the equivalent circle, the edge value): the
+    less compressive of the axial stress along the axis and the hoop stress around it — the
+    place on the rim where the contact-edge peak stands (μ = 0), or the worst sliding
+    direction (μ > 0; the events do not give it). Bilinear in c/t and ρ/c."""
+    rim = np.maximum(wall["rim_axial"], wall["rim_hoop"])
+    grid = wall["c_over_t"]
+    i = np.clip(np.searchsorted(grid, u) - 1, 0, grid.size - 2)
+    fu = np.clip((u - grid[i]) / (grid[i + 1] - grid[i]), 0.0, 1.0)
+    rho = np.clip(radius, RHO[0], RHO[-1])
+    j = np.clip(np.searchsorted(RHO, rho) - 1, 0, RHO.size - 2)
+    fr = (rho - RHO[j]) / (RHO[j + 1] - RHO[j])
+    return ((1 - fu) * ((1 - fr) * rim[i, j] + fr * rim[i, j + 1])
+            + fu * ((1 - fr) * rim[i + 1, j] + fr * rim[i + 1, j + 1]))
 
 
-def _line(length: float, r_star: float, e_star: float, r_mid: float, support: str, *,
+def _line(length: float, r_star: float, e_star: float, support: str, *,
           f: np.ndarray, mu: np.ndarray, nu: float, t: float, ell: float, m_out: float,
-          m_in: float, mu_cap: float, depth: Any) -> dict[str, np.ndarray]:
-    """Line contacts: Hertz line contact (McEwen's sliding field) on the ring."""
+          m_in: float, mu_cap: float, depth: Any, r_mid: float,
+          free_length: float) -> dict[str, np.ndarray]:
+    """Line contacts: Hertz line contact (McEwen's sliding field) on the cylindrical wall."""
     w = f / length
     lc = line_contact(w, r_star, e_star)
     half = lc["b"]
@@ -393,10 +405,10 @@ def _line(length: float, r_star: float, e_star: float, r_mid: float, support: st
             f"half-width b = {half.ravel()[k]:.4g} m must be < the wall thickness t = {t:.4g} m "
             "(a contact small against the wall)")
     p0 = lc["p0"]
-    prof = ring_stress_profile(r_mid, t, support, m_in, m_out)
-    scale = w * r_mid / t**2
+    prof = line_load_profile(r_mid, t, nu, length, support, free_length, m_in, m_out)
+    scale = f / t**2
     inner = prof["inner_peak"] * scale
-    inner_area = prof["inner_angle"] * (r_mid - 0.5 * t) * length * np.ones_like(f)
+    inner_area = prof["inner_area"] * np.ones_like(f)
     table = ea.line_table(m_out, mu_cap)
     contact = 2.0 * mu * p0
     if depth is not None:
@@ -408,7 +420,7 @@ def _line(length: float, r_star: float, e_star: float, r_mid: float, support: st
     near = contact + bending
     area_near = np.where(near > 0, length * half * ea.interp_mu_tau(table, mu, tau), 0.0)
     ring = prof["outer_peak"] * scale
-    area_ring = prof["outer_angle"] * (r_mid + 0.5 * t) * length * np.ones_like(f)
+    area_ring = prof["outer_area"] * np.ones_like(f)
     outer, outer_area = _combine(near, area_near, ring, area_ring, m_out)
     return {"outer_sigma1_max": outer, "inner_sigma1_max": inner,
             "outer_effective_area": outer_area, "inner_effective_area": inner_area,
