@@ -180,3 +180,94 @@ fn events_are_the_same_on_two_threads_and_after_a_restart() {
     plain.step(10).unwrap();
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The head-on pair part-way through its contact (events recorded, so every section of the
+/// checkpoint is there).
+fn head_on_in_contact() -> Simulation {
+    let mut sim = Simulation::new(&head_on(45e9, 1.0, 0.2).0).unwrap();
+    for _ in 0..10_000 {
+        if !sim.open_events().is_empty() {
+            sim.step(3).unwrap();
+            return sim;
+        }
+        sim.step(1).unwrap();
+    }
+    panic!("the spheres never touched");
+}
+
+fn refusal(sim: &mut Simulation, bytes: &[u8]) -> String {
+    match sim.restore_checkpoint_bytes(bytes, "mem.ck") {
+        Err(demfem::DemfemError::Io { path, detail }) => {
+            assert_eq!(path, "mem.ck");
+            detail
+        }
+        r => panic!("expected a refusal naming the source, got {r:?}"),
+    }
+}
+
+#[test]
+fn old_truncated_corrupt_and_foreign_checkpoints_are_refused_by_name() {
+    let saved = head_on_in_contact();
+    let bytes = saved.checkpoint_bytes();
+    let mut fresh = Simulation::new(&head_on(45e9, 1.0, 0.2).0).unwrap();
+    let before = bits(&fresh);
+
+    // the checkpoint of an earlier demfem (magic DEMFEMCK, version 3)
+    let mut old = b"DEMFEMCK".to_vec();
+    old.extend_from_slice(&3u32.to_le_bytes());
+    old.extend_from_slice(&bytes[12..]);
+    let why = refusal(&mut fresh, &old);
+    assert!(
+        why.contains("older demfem checkpoint format") && why.contains("rerun from the start"),
+        "{why}"
+    );
+    // every truncation, trailing bytes, a section renamed, a count changed, a bad flag
+    for n in 0..bytes.len() {
+        assert!(
+            fresh
+                .restore_checkpoint_bytes(&bytes[..n], "mem.ck")
+                .is_err(),
+            "a checkpoint cut at {n} of {} bytes was read",
+            bytes.len()
+        );
+    }
+    let mut longer = bytes.clone();
+    longer.extend_from_slice(&[0; 3]);
+    assert!(refusal(&mut fresh, &longer).contains("3 bytes left"));
+    let at = |name: &[u8]| bytes.windows(name.len()).position(|w| w == name).unwrap();
+    let mut renamed = bytes.clone();
+    renamed[at(b"velocity")] = b'V';
+    let why = refusal(&mut fresh, &renamed);
+    assert!(why.contains(r#"where "velocity" was expected"#), "{why}");
+    let mut counted = bytes.clone();
+    let c = at(b"omega") + 5;
+    counted[c] = 3; // 3 spheres' spins in a scene of 2
+    let why = refusal(&mut fresh, &counted);
+    assert!(
+        why.contains("omega: 3 entries saved, this model has 2"),
+        "{why}"
+    );
+    let mut flag = bytes.clone();
+    flag[at(b"alive") + 5 + 8] = 7;
+    assert!(refusal(&mut fresh, &flag).contains("not a flag"));
+    // a state of another kind
+    let fem = demfem::state_io::StateWriter::new(demfem::state_io::StateKind::Fem).finish();
+    let why = refusal(&mut fresh, &fem);
+    assert!(
+        why.contains("an FEM explicit-run state") && why.contains("not a DEM"),
+        "{why}"
+    );
+    assert_eq!(
+        bits(&fresh),
+        before,
+        "a refused checkpoint changed the simulation"
+    );
+
+    // the intact bytes restore, and the run goes on as the saved one does
+    let mut saved = saved;
+    fresh.restore_checkpoint_bytes(&bytes, "mem.ck").unwrap();
+    saved.step(100).unwrap();
+    fresh.step(100).unwrap();
+    assert_eq!(bits(&fresh), bits(&saved));
+    assert_eq!(fresh.open_events(), saved.open_events());
+}

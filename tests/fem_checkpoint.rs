@@ -122,3 +122,33 @@ fn a_state_of_another_model_is_refused_and_changes_nothing() {
     longer.push(0);
     assert!(build(3).restore_state(&longer).is_err());
 }
+
+#[test]
+fn a_dem_checkpoint_is_refused_by_its_kind() {
+    use demfem::dem::{EffectSet, Material, ParticleInit, Scene, Simulation};
+    use demfem::geometry::Vec3;
+
+    let p = ParticleInit::at_rest(vec![Vec3::new(0.0, 0.0, 0.01)], vec![0.005]);
+    let glass = Material::new(1e8, 0.22, 2230.0, 0.0, 1.0, 0.0);
+    let mut scene = Scene::new(p, vec![glass], vec![], EffectSet::empty());
+    scene.gravity = Vec3::ZERO;
+    let mut dem = Simulation::new(&scene).unwrap();
+    dem.step(3).unwrap();
+    let mut s = build(2);
+    let before = bits(&s);
+    match s.restore_state(&dem.checkpoint_bytes()) {
+        Err(DemfemError::ShapeMismatch { detail, .. }) => assert!(
+            detail.contains("a DEM checkpoint") && detail.contains("not an FEM"),
+            "{detail}"
+        ),
+        r => panic!("expected a refusal, got {r:?}"),
+    }
+    assert!(bits(&s) == before);
+    // and the reverse: this solver's state into the DEM simulation
+    match dem.restore_checkpoint_bytes(&s.save_state(), "fem.state") {
+        Err(DemfemError::Io { detail, .. }) => {
+            assert!(detail.contains("an FEM explicit-run state"), "{detail}")
+        }
+        r => panic!("expected a refusal, got {r:?}"),
+    }
+}

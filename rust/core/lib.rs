@@ -15,5 +15,6 @@ pub mod error;
 pub mod fem;
 pub mod geometry;
 pub mod rigid;
+pub mod state_io;
 
 pub use error::{DemfemError, Result};

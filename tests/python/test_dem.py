@@ -62,6 +62,34 @@ def test_checkpoint_restart_is_bitwise_identical(tmp_path):
     assert np.array_equal(a.angular_velocities(), b.angular_velocities())
 
 
+def test_old_truncated_and_fem_checkpoints_are_refused_by_name(tmp_path):
+    from demfem.errors import DemfemIOError
+
+    a = belt_sphere()
+    a.step(30)
+    path = tmp_path / "state.ck"
+    a.save_checkpoint(path)
+    data = path.read_bytes()
+    assert data[:8] == b"DEMFEMST"  # the one checkpoint format, kind "dem"
+    b = belt_sphere()
+    old = tmp_path / "old.ck"  # a checkpoint of an earlier demfem: DEMFEMCK, version 3
+    old.write_bytes(b"DEMFEMCK" + (3).to_bytes(4, "little") + data[12:])
+    with pytest.raises(DemfemIOError, match=r"old\.ck.*older demfem checkpoint format.*rerun"):
+        b.load_checkpoint(old)
+    cut = tmp_path / "cut.ck"
+    cut.write_bytes(data[:-5])
+    with pytest.raises(DemfemIOError, match=r"cut\.ck.*truncated"):
+        b.load_checkpoint(cut)
+    fem = tmp_path / "fem.ck"  # an FEM solver's state: the same format, kind "fem"
+    fem.write_bytes(b"DEMFEMST" + (2).to_bytes(4, "little") + b"\x04kind"
+                    + (3).to_bytes(8, "little") + b"fem")
+    with pytest.raises(DemfemIOError, match="an FEM explicit-run state .*not a DEM checkpoint"):
+        b.load_checkpoint(fem)
+    assert b.time == 0.0
+    b.load_checkpoint(path)
+    assert b.time == a.time
+
+
 def test_anchor_table_runs_and_reports_state():
     sim = dem.DemSimulation._anchor_table(1e8, start="packed", threads=2)
     assert len(sim) == 840 and sim.dt == pytest.approx(0.5 * R * (2230.0 / 1e8) ** 0.5)

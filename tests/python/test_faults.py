@@ -481,6 +481,21 @@ def test_fem_restore_state_refuses_a_damaged_file_by_name(tmp_path, damage, why)
     np.testing.assert_array_equal(model.solver.displacement(), u)
 
 
+def test_fem_restore_state_refuses_dem_checkpoints_by_name(tmp_path):
+    sim = dem.DemSimulation(np.array([[0.0, 0.0, 0.01]]), np.array([0.005]),
+                            [dem.material(1e8, 0.22, 2230.0)], [], [], gravity=(0.0, 0.0, 0.0))
+    path = tmp_path / "dem.state"
+    sim.save_checkpoint(path)
+    other = _ball_model()
+    with pytest.raises(CheckpointError, match=r"dem\.state.*a DEM checkpoint.*--fresh"):
+        other.restore_state(path)
+    data = path.read_bytes()  # a checkpoint of an earlier demfem: DEMFEMCK, version 3
+    path.write_bytes(b"DEMFEMCK" + (3).to_bytes(4, "little") + data[12:])
+    with pytest.raises(CheckpointError, match=r"dem\.state.*older demfem checkpoint format"):
+        other.restore_state(path)
+    assert other.time == 0.0
+
+
 def test_fem_state_of_another_model_names_the_file():
     from demfem.errors import ShapeError
     from demfem.fem import Body, FemModel

@@ -450,8 +450,13 @@ class FemModel:
 
 
 #: Header of a state file of :meth:`FemModel.save_state`: this magic, the format (u32), the
-#: payload's length (u64) and SHA-256 (32 bytes), then the solver's own state bytes.
+#: payload's length (u64) and SHA-256 (32 bytes), then the solver's own state bytes (the one
+#: checkpoint format of the core, ``rust/core/state_io.rs``: the magic ``DEMFEMST``, its
+#: format, then named sections, the first the kind ``fem``; a DEM checkpoint is the same
+#: format of kind ``dem``). The magic is the one the DEM checkpoints of earlier demfem
+#: versions began with; those have a format other than 1 and are refused as such.
 STATE_MAGIC = b"DEMFEMCK"
+_CORE_MAGIC = b"DEMFEMST"
 _STATE_FORMAT = 1
 _STATE_HEADER = struct.Struct("<8sIQ32s")
 
@@ -471,13 +476,20 @@ def _unwrap_state(data: bytes, path: Path) -> bytes:
                                "start the run afresh (fresh=True, --fresh on the command line)")
 
     if len(data) < _STATE_HEADER.size or data[:8] != STATE_MAGIC:
-        if data[:8] == b"DEMFEMST":
+        if data[:8] == _CORE_MAGIC:
+            # the core's bytes without this header: name the kind of its first section
+            if data[12:28] == b"\x04kind" + struct.pack("<Q", 3) + b"dem":
+                raise damaged("a DEM checkpoint (Simulation.save_checkpoint), not an FEM "
+                              "state")
             raise damaged("a state of an earlier demfem version, without the checksum this "
                           "one needs")
         raise damaged(f"not a demfem FEM state file ({len(data)} bytes, no "
                       f"{STATE_MAGIC.decode()} header)")
     _, fmt, length, digest = _STATE_HEADER.unpack_from(data)
     if fmt != _STATE_FORMAT:
+        if data[_STATE_HEADER.size:_STATE_HEADER.size + 8] != _CORE_MAGIC:
+            raise damaged("a DEM checkpoint written by an older demfem checkpoint format, "
+                          "not an FEM state")
         raise damaged(f"state file format {fmt}, this version reads {_STATE_FORMAT}")
     payload = data[_STATE_HEADER.size:]
     if len(payload) != length:

@@ -1,125 +1,97 @@
-//! Checkpoint and restart: the dynamic state of a simulation (time, kinematics, alive flags,
-//! Verlet lists with their tangential-spring history and contact flags, rebuild references)
-//! in a little-endian binary file with a versioned header. A run restored into a simulation
-//! built from the same scene continues bitwise identically to an uninterrupted one.
+//! Checkpoint and restart of a DEM simulation, in the one checkpoint format of demfem
+//! ([`crate::state_io`], kind `dem`). A run restored into a simulation built from the same
+//! scene continues bitwise identically to an uninterrupted one.
 //!
 //! The static scene (particles' radii, materials, walls, effects, dt) is not stored; a
 //! fingerprint of it is, and loading into a simulation whose scene differs is refused.
 //! Records (frames, onsets, logged events) are outputs and are not stored; the accumulators
-//! of the contacts still open are (version 3), so a resumed run logs the same events.
+//! of the contacts still open are, so a resumed run logs the same events.
 //!
-//! Files are written atomically: to `<path>.tmp`, fsync, rename over `<path>`.
+//! Sections, in order (n particles, W walls, P listed pairs, S = n × stride wall slots):
+//!
+//! | section | entries | content |
+//! |---|---|---|
+//! | `kind` | 3 | the bytes `dem` |
+//! | `scene_fingerprint` | 1 | u64, [`Simulation::scene_fingerprint`] |
+//! | `time` | 1 | f64, simulated time, s |
+//! | `steps`, `rebuilds` | 1 each | u64, steps taken, neighbour-list rebuilds |
+//! | `needs_rebuild` | 1 | flag: the lists are rebuilt before the next step |
+//! | `position`, `velocity`, `omega` | n | 3-vectors: m, m/s, rad/s |
+//! | `reference_position` | n | 3-vectors, m: positions at the last rebuild |
+//! | `alive` | n | flags |
+//! | `reference_wall_offset`, `reference_wall_angle` | W | 3-vectors, m; f64, rad: walls at the last rebuild |
+//! | `pair.i`, `pair.j` | P | u32: the Verlet list, i < j |
+//! | `pair.active`, `pair.history` | P | flag: in contact; 3-vector, m: tangential spring ξ |
+//! | `wall_stride` | 1 | u64: slots per particle |
+//! | `slot.wall`, `slot.triangle` | S | u32: wall (u32::MAX: empty slot), triangle of a mesh wall |
+//! | `slot.active`, `slot.history` | S | flag; 3-vector, m, as for pairs |
+//! | `record_events` | 1 | flag: the accumulators follow |
+//! | `event.*` | P + S | when recorded, pairs then slots: `open` (flag), `start_step` (u64), `normal_speed`, `tangential_speed` (m/s), `peak_normal_force`, `peak_tangential_force` (N), `normal_impulse` (N s), `max_overlap` (m), `position`, `partner_position` (3-vectors, m) |
+//!
+//! Files are written atomically ([`crate::state_io::write_file_atomic`]). Checkpoints of
+//! earlier demfem versions (magic `DEMFEMCK`) are refused: rerun those from the start.
 
-use std::io::Write;
 use std::path::Path;
 
 use crate::dem::simulation::{EventAcc, PairContact, Simulation, WallContact};
 use crate::error::{DemfemError, Result};
-use crate::geometry::Vec3;
+use crate::state_io::{read_file, write_file_atomic, StateKind, StateReader, StateWriter};
 
-const MAGIC: &[u8; 8] = b"DEMFEMCK";
-/// Version of the checkpoint format.
-pub const CHECKPOINT_VERSION: u32 = 3;
-/// The oldest version this build still reads (version 2: no event accumulators).
-const OLDEST_VERSION: u32 = 2;
-
-struct Writer(Vec<u8>);
-impl Writer {
-    fn u8(&mut self, v: u8) {
-        self.0.push(v);
-    }
-    fn u32(&mut self, v: u32) {
-        self.0.extend_from_slice(&v.to_le_bytes());
-    }
-    fn u64(&mut self, v: u64) {
-        self.0.extend_from_slice(&v.to_le_bytes());
-    }
-    fn f64(&mut self, v: f64) {
-        self.0.extend_from_slice(&v.to_bits().to_le_bytes());
-    }
-    fn vec3(&mut self, v: Vec3) {
-        self.f64(v.x);
-        self.f64(v.y);
-        self.f64(v.z);
-    }
-    fn event(&mut self, a: &EventAcc) {
-        self.u8(a.open as u8);
-        self.u64(a.start_step);
-        for v in [
-            a.normal_speed,
-            a.tangential_speed,
-            a.peak_normal_force,
-            a.normal_impulse,
-            a.peak_tangential_force,
-            a.max_overlap,
-        ] {
-            self.f64(v);
-        }
-        self.vec3(a.position);
-        self.vec3(a.partner_position);
+fn bad(detail: String) -> DemfemError {
+    DemfemError::ShapeMismatch {
+        field: "saved state".into(),
+        detail,
     }
 }
 
-struct Reader<'a> {
-    data: &'a [u8],
-    at: usize,
-    path: &'a str,
+fn write_events(w: &mut StateWriter, accs: &[&EventAcc]) {
+    let f64s = |f: fn(&EventAcc) -> f64| accs.iter().map(|a| f(a)).collect::<Vec<_>>();
+    w.bools(
+        "event.open",
+        &accs.iter().map(|a| a.open).collect::<Vec<_>>(),
+    );
+    let start: Vec<u64> = accs.iter().map(|a| a.start_step).collect();
+    w.u64s("event.start_step", &start);
+    w.f64s("event.normal_speed", &f64s(|a| a.normal_speed));
+    w.f64s("event.tangential_speed", &f64s(|a| a.tangential_speed));
+    w.f64s("event.peak_normal_force", &f64s(|a| a.peak_normal_force));
+    w.f64s(
+        "event.peak_tangential_force",
+        &f64s(|a| a.peak_tangential_force),
+    );
+    w.f64s("event.normal_impulse", &f64s(|a| a.normal_impulse));
+    w.f64s("event.max_overlap", &f64s(|a| a.max_overlap));
+    let pos: Vec<_> = accs.iter().map(|a| a.position).collect();
+    w.vectors("event.position", &pos);
+    let partner: Vec<_> = accs.iter().map(|a| a.partner_position).collect();
+    w.vectors("event.partner_position", &partner);
 }
-impl Reader<'_> {
-    fn take(&mut self, n: usize) -> Result<&[u8]> {
-        if self.at + n > self.data.len() {
-            return Err(DemfemError::Io {
-                path: self.path.into(),
-                detail: "truncated checkpoint".into(),
-            });
-        }
-        let s = &self.data[self.at..self.at + n];
-        self.at += n;
-        Ok(s)
-    }
-    fn u8(&mut self) -> Result<u8> {
-        Ok(self.take(1)?[0])
-    }
-    fn u32(&mut self) -> Result<u32> {
-        let mut b = [0u8; 4];
-        b.copy_from_slice(self.take(4)?);
-        Ok(u32::from_le_bytes(b))
-    }
-    fn u64(&mut self) -> Result<u64> {
-        let mut b = [0u8; 8];
-        b.copy_from_slice(self.take(8)?);
-        Ok(u64::from_le_bytes(b))
-    }
-    fn f64(&mut self) -> Result<f64> {
-        Ok(f64::from_bits(self.u64()?))
-    }
-    fn vec3(&mut self) -> Result<Vec3> {
-        Ok(Vec3::new(self.f64()?, self.f64()?, self.f64()?))
-    }
-    fn event(&mut self) -> Result<EventAcc> {
-        Ok(EventAcc {
-            open: self.u8()? != 0,
-            start_step: self.u64()?,
-            normal_speed: self.f64()?,
-            tangential_speed: self.f64()?,
-            peak_normal_force: self.f64()?,
-            normal_impulse: self.f64()?,
-            peak_tangential_force: self.f64()?,
-            max_overlap: self.f64()?,
-            position: self.vec3()?,
-            partner_position: self.vec3()?,
+
+fn read_events(r: &mut StateReader<'_>, n: usize) -> Result<Vec<EventAcc>> {
+    let open = r.bools("event.open", Some(n))?;
+    let start_step = r.u64s("event.start_step", Some(n))?;
+    let normal_speed = r.f64s("event.normal_speed", Some(n))?;
+    let tangential_speed = r.f64s("event.tangential_speed", Some(n))?;
+    let peak_normal_force = r.f64s("event.peak_normal_force", Some(n))?;
+    let peak_tangential_force = r.f64s("event.peak_tangential_force", Some(n))?;
+    let normal_impulse = r.f64s("event.normal_impulse", Some(n))?;
+    let max_overlap = r.f64s("event.max_overlap", Some(n))?;
+    let position = r.vectors("event.position", Some(n))?;
+    let partner_position = r.vectors("event.partner_position", Some(n))?;
+    Ok((0..n)
+        .map(|k| EventAcc {
+            open: open[k],
+            start_step: start_step[k],
+            normal_speed: normal_speed[k],
+            tangential_speed: tangential_speed[k],
+            peak_normal_force: peak_normal_force[k],
+            normal_impulse: normal_impulse[k],
+            peak_tangential_force: peak_tangential_force[k],
+            max_overlap: max_overlap[k],
+            position: position[k],
+            partner_position: partner_position[k],
         })
-    }
-    fn count(&mut self, max: usize, what: &str) -> Result<usize> {
-        let n = self.u64()?;
-        if n > max as u64 {
-            return Err(DemfemError::Io {
-                path: self.path.into(),
-                detail: format!("corrupt checkpoint: {what} count {n} > {max}"),
-            });
-        }
-        Ok(n as usize)
-    }
+        .collect())
 }
 
 /// FNV-1a, 64 bit: a stable hash for the scene fingerprint.
@@ -161,219 +133,166 @@ impl Simulation {
 
     /// The checkpoint as bytes.
     pub fn checkpoint_bytes(&self) -> Vec<u8> {
-        let mut w = Writer(Vec::with_capacity(
-            64 + self.position.len() * 100 + self.pairs.len() * 40,
-        ));
-        w.0.extend_from_slice(MAGIC);
-        w.u32(CHECKPOINT_VERSION);
-        w.u64(self.scene_fingerprint());
-        w.u64(self.position.len() as u64);
-        w.u64(self.walls.len() as u64);
-        w.f64(self.time);
-        w.u64(self.steps);
-        w.u64(self.rebuilds);
-        w.u8(self.needs_rebuild as u8);
-        for i in 0..self.position.len() {
-            w.vec3(self.position[i]);
-            w.vec3(self.velocity[i]);
-            w.vec3(self.omega[i]);
-            w.vec3(self.reference_position[i]);
-            w.u8(self.alive[i] as u8);
-        }
-        for v in &self.reference_wall_offset {
-            w.vec3(*v);
-        }
-        for a in &self.reference_wall_angle {
-            w.f64(*a);
-        }
-        w.u64(self.pairs.len() as u64);
-        for (p, &active) in self.pairs.iter().zip(&self.pair_active) {
-            w.u32(p.i);
-            w.u32(p.j);
-            w.u8(active as u8);
-            w.vec3(p.history);
-        }
-        w.u64(self.wall_stride as u64);
-        w.u64(self.wall_slots.len() as u64);
-        for s in &self.wall_slots {
-            w.u32(s.wall);
-            w.u32(s.triangle);
-            w.u8(s.active as u8);
-            w.vec3(s.history);
-        }
-        w.u8(self.record_events as u8);
+        let mut w = StateWriter::new(StateKind::Dem);
+        w.u64("scene_fingerprint", self.scene_fingerprint());
+        w.f64("time", self.time);
+        w.u64("steps", self.steps);
+        w.u64("rebuilds", self.rebuilds);
+        w.bool("needs_rebuild", self.needs_rebuild);
+        w.vectors("position", &self.position);
+        w.vectors("velocity", &self.velocity);
+        w.vectors("omega", &self.omega);
+        w.vectors("reference_position", &self.reference_position);
+        w.bools("alive", &self.alive);
+        w.vectors("reference_wall_offset", &self.reference_wall_offset);
+        w.f64s("reference_wall_angle", &self.reference_wall_angle);
+        w.u32s(
+            "pair.i",
+            &self.pairs.iter().map(|p| p.i).collect::<Vec<_>>(),
+        );
+        w.u32s(
+            "pair.j",
+            &self.pairs.iter().map(|p| p.j).collect::<Vec<_>>(),
+        );
+        w.bools("pair.active", &self.pair_active);
+        let history: Vec<_> = self.pairs.iter().map(|p| p.history).collect();
+        w.vectors("pair.history", &history);
+        w.u64("wall_stride", self.wall_stride as u64);
+        let slots = &self.wall_slots;
+        w.u32s(
+            "slot.wall",
+            &slots.iter().map(|s| s.wall).collect::<Vec<_>>(),
+        );
+        let triangle: Vec<_> = slots.iter().map(|s| s.triangle).collect();
+        w.u32s("slot.triangle", &triangle);
+        w.bools(
+            "slot.active",
+            &slots.iter().map(|s| s.active).collect::<Vec<_>>(),
+        );
+        let history: Vec<_> = slots.iter().map(|s| s.history).collect();
+        w.vectors("slot.history", &history);
+        w.bool("record_events", self.record_events);
         if self.record_events {
-            for a in self.pair_event.iter().chain(&self.wall_event) {
-                w.event(a);
-            }
+            let accs: Vec<&EventAcc> = self.pair_event.iter().chain(&self.wall_event).collect();
+            write_events(&mut w, &accs);
         }
-        w.0
+        w.finish()
     }
 
     /// Write a checkpoint atomically (temp file, fsync, rename).
     pub fn save_checkpoint(&self, path: &Path) -> Result<()> {
-        let io = |e: std::io::Error| DemfemError::Io {
-            path: path.display().to_string(),
-            detail: e.to_string(),
-        };
-        let mut tmp = path.as_os_str().to_owned();
-        tmp.push(".tmp");
-        let tmp = std::path::PathBuf::from(tmp);
-        {
-            let mut f = std::fs::File::create(&tmp).map_err(io)?;
-            f.write_all(&self.checkpoint_bytes()).map_err(io)?;
-            f.sync_all().map_err(io)?;
-        }
-        std::fs::rename(&tmp, path).map_err(io)?;
-        if let Some(dir) = path.parent() {
-            // make the rename itself durable; not every platform can open a directory
-            if let Ok(d) = std::fs::File::open(if dir.as_os_str().is_empty() {
-                Path::new(".")
-            } else {
-                dir
-            }) {
-                let _ = d.sync_all();
-            }
-        }
-        Ok(())
+        write_file_atomic(path, &self.checkpoint_bytes())
     }
 
-    /// Restore the state from checkpoint bytes; `path` only names the source in errors.
+    /// Restore the state from checkpoint bytes; `path` only names the source in errors
+    /// ([`DemfemError::Io`] naming it). Nothing changes unless the whole state fits.
     pub fn restore_checkpoint_bytes(&mut self, data: &[u8], path: &str) -> Result<()> {
-        let mut r = Reader { data, at: 0, path };
-        let bad = |detail: String| DemfemError::Io {
-            path: path.into(),
-            detail,
-        };
-        if r.take(8)? != MAGIC {
-            return Err(bad("not a demfem checkpoint (bad magic)".into()));
-        }
-        let version = r.u32()?;
-        if !(OLDEST_VERSION..=CHECKPOINT_VERSION).contains(&version) {
-            return Err(bad(format!(
-                "checkpoint version {version}, this build reads {OLDEST_VERSION} to \
-                 {CHECKPOINT_VERSION}"
-            )));
-        }
-        let fp = r.u64()?;
-        if fp != self.scene_fingerprint() {
+        self.restore(data).map_err(|e| match e {
+            DemfemError::ShapeMismatch { detail, .. } => DemfemError::Io {
+                path: path.into(),
+                detail,
+            },
+            e => e,
+        })
+    }
+
+    fn restore(&mut self, data: &[u8]) -> Result<()> {
+        let mut r = StateReader::new(data, StateKind::Dem)?;
+        if r.u64("scene_fingerprint")? != self.scene_fingerprint() {
             return Err(bad(
-                "checkpoint was written by a different scene (fingerprint mismatch)".into(),
+                "checkpoint written by a different scene (fingerprint mismatch)".into(),
             ));
         }
         let n = self.position.len();
-        if r.u64()? != n as u64 || r.u64()? != self.walls.len() as u64 {
-            return Err(bad("particle or wall count differs from the scene".into()));
-        }
-        let time = r.f64()?;
-        let steps = r.u64()?;
-        let rebuilds = r.u64()?;
-        let needs_rebuild = r.u8()? != 0;
-        let mut position = Vec::with_capacity(n);
-        let mut velocity = Vec::with_capacity(n);
-        let mut omega = Vec::with_capacity(n);
-        let mut reference = Vec::with_capacity(n);
-        let mut alive = Vec::with_capacity(n);
-        for _ in 0..n {
-            position.push(r.vec3()?);
-            velocity.push(r.vec3()?);
-            omega.push(r.vec3()?);
-            reference.push(r.vec3()?);
-            alive.push(r.u8()? != 0);
-        }
-        let mut wall_ref = Vec::with_capacity(self.walls.len());
-        for _ in 0..self.walls.len() {
-            wall_ref.push(r.vec3()?);
-        }
-        let mut wall_angle = Vec::with_capacity(self.walls.len());
-        for _ in 0..self.walls.len() {
-            wall_angle.push(r.f64()?);
-        }
-        let n_pairs = r.count(data.len() / 33 + 1, "pair")?;
+        let n_walls = self.walls.len();
+        let time = r.f64("time")?;
+        let steps = r.u64("steps")?;
+        let rebuilds = r.u64("rebuilds")?;
+        let needs_rebuild = r.bool("needs_rebuild")?;
+        let position = r.vectors("position", Some(n))?;
+        let velocity = r.vectors("velocity", Some(n))?;
+        let omega = r.vectors("omega", Some(n))?;
+        let reference = r.vectors("reference_position", Some(n))?;
+        let alive = r.bools("alive", Some(n))?;
+        let wall_ref = r.vectors("reference_wall_offset", Some(n_walls))?;
+        let wall_angle = r.f64s("reference_wall_angle", Some(n_walls))?;
+        let pair_i = r.u32s("pair.i", None)?;
+        let n_pairs = pair_i.len();
+        let pair_j = r.u32s("pair.j", Some(n_pairs))?;
+        let pair_active = r.bools("pair.active", Some(n_pairs))?;
+        let pair_history = r.vectors("pair.history", Some(n_pairs))?;
         let mut pairs = Vec::with_capacity(n_pairs);
-        let mut pair_active = Vec::with_capacity(n_pairs);
-        for _ in 0..n_pairs {
-            let i = r.u32()?;
-            let j = r.u32()?;
+        for ((&i, &j), &history) in pair_i.iter().zip(&pair_j).zip(&pair_history) {
             if i >= j || j as usize >= n {
                 return Err(bad(format!("corrupt checkpoint: pair ({i}, {j})")));
             }
-            let active = r.u8()? != 0;
-            let history = r.vec3()?;
-            pairs.push(PairContact {
-                i,
-                j,
-                history,
-                ..Default::default()
-            });
-            pair_active.push(active);
+            pairs.push(PairContact { i, j, history });
         }
         let pair_onset = vec![false; n_pairs];
         // a mesh wall has a slot per triangle within reach
-        let max_stride = self
-            .walls
-            .iter()
-            .map(|w| w.mesh().map_or(1, |m| m.triangles().len()))
-            .sum::<usize>();
-        let stride = r.count(max_stride.max(1), "wall stride")?.max(1);
-        let n_slots = r.count(n * stride, "wall slot")?;
-        if n_slots != n * stride {
-            return Err(bad("corrupt checkpoint: wall slot count".into()));
+        let triangles = |w: u32| {
+            self.walls[w as usize]
+                .mesh()
+                .map_or(1, |m| m.triangles().len())
+        };
+        let max_stride = (0..n_walls as u32).map(triangles).sum::<usize>().max(1);
+        let stride = r.u64("wall_stride")?;
+        if stride > max_stride as u64 {
+            return Err(bad(format!(
+                "corrupt checkpoint: wall stride {stride} > {max_stride}"
+            )));
         }
+        let stride = (stride as usize).max(1);
+        let n_slots = n * stride;
+        let slot_wall = r.u32s("slot.wall", Some(n_slots))?;
+        let slot_triangle = r.u32s("slot.triangle", Some(n_slots))?;
+        let slot_active = r.bools("slot.active", Some(n_slots))?;
+        let slot_history = r.vectors("slot.history", Some(n_slots))?;
         let mut slots = Vec::with_capacity(n_slots);
-        for _ in 0..n_slots {
-            let wall = r.u32()?;
-            if wall != u32::MAX && wall as usize >= self.walls.len() {
-                return Err(bad(format!("corrupt checkpoint: wall index {wall}")));
-            }
-            let triangle = r.u32()?;
+        for k in 0..n_slots {
+            let (wall, triangle) = (slot_wall[k], slot_triangle[k]);
             if wall != u32::MAX {
-                let n_triangles = self.walls[wall as usize]
-                    .mesh()
-                    .map_or(1, |m| m.triangles().len());
-                if triangle as usize >= n_triangles {
+                if wall as usize >= n_walls {
+                    return Err(bad(format!("corrupt checkpoint: wall index {wall}")));
+                }
+                if triangle as usize >= triangles(wall) {
                     return Err(bad(format!(
                         "corrupt checkpoint: triangle index {triangle}"
                     )));
                 }
             }
-            let active = r.u8()? != 0;
-            let history = r.vec3()?;
             slots.push(WallContact {
                 wall,
                 triangle,
-                active,
-                history,
+                active: slot_active[k],
+                history: slot_history[k],
                 ..Default::default()
             });
         }
-        // version 3: the event accumulators, when the writing run recorded events
-        let saved_events = version >= 3 && r.u8()? != 0;
-        let mut accs = Vec::new();
-        if saved_events {
-            for _ in 0..n_pairs + n_slots {
-                accs.push(r.event()?);
-            }
-        }
-        if r.at != data.len() {
-            return Err(bad("trailing bytes after checkpoint".into()));
-        }
-        let (pair_event, wall_event) = if !self.record_events {
-            (Vec::new(), Vec::new())
-        } else if saved_events {
-            let wall = accs.split_off(n_pairs);
-            (accs, wall)
+        let saved = if r.bool("record_events")? {
+            Some(read_events(&mut r, n_pairs + n_slots)?)
         } else {
-            // a checkpoint without events: the contacts open now start their events here
-            let open = |active: bool| EventAcc {
-                open: active,
-                start_step: steps,
-                ..Default::default()
-            };
-            (
-                pair_active.iter().map(|&a| open(a)).collect(),
-                slots.iter().map(|s| open(s.active)).collect(),
-            )
+            None
+        };
+        r.finish()?;
+        let (pair_event, wall_event) = match saved {
+            _ if !self.record_events => (Vec::new(), Vec::new()),
+            Some(mut accs) => {
+                let wall = accs.split_off(n_pairs);
+                (accs, wall)
+            }
+            None => {
+                // a checkpoint without events: the contacts open now start their events here
+                let open = |active: bool| EventAcc {
+                    open: active,
+                    start_step: steps,
+                    ..Default::default()
+                };
+                (
+                    pair_active.iter().map(|&a| open(a)).collect(),
+                    slots.iter().map(|s| open(s.active)).collect(),
+                )
+            }
         };
         self.time = time;
         self.steps = steps;
@@ -402,10 +321,7 @@ impl Simulation {
     /// Load a checkpoint written by [`Simulation::save_checkpoint`] from a simulation built
     /// from the same scene.
     pub fn load_checkpoint(&mut self, path: &Path) -> Result<()> {
-        let data = std::fs::read(path).map_err(|e| DemfemError::Io {
-            path: path.display().to_string(),
-            detail: e.to_string(),
-        })?;
+        let data = read_file(path)?;
         self.restore_checkpoint_bytes(&data, &path.display().to_string())
     }
 }

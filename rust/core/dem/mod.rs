@@ -23,7 +23,6 @@ mod scene;
 mod simulation;
 pub mod table;
 
-pub use checkpoint::CHECKPOINT_VERSION;
 pub use effects::{Effect, EffectSet};
 pub use material::{DemContactLaw, Material, PairLaw};
 pub use record::{ContactEvent, ContactOnset, ContactRecord, Frame, Partner};

@@ -27,7 +27,6 @@ pub mod mesh;
 mod reduce;
 pub mod shell;
 pub mod stable_step;
-pub mod state_io;
 pub mod static_solve;
 pub mod stress;
 pub mod tet_elements;

@@ -1,9 +1,9 @@
-//! Save and restore the contact model's dynamic state (see [`crate::fem::state_io`]): stick
+//! Save and restore the contact model's dynamic state (see [`crate::state_io`]): stick
 //! forces, the contact memory of every surface node, the work accumulators, the output
 //! history and the broad phase's lists, so that a restored run continues bitwise.
 
 use crate::error::{DemfemError, Result};
-use crate::fem::state_io::{StateReader, StateWriter};
+use crate::state_io::{StateReader, StateWriter};
 
 use super::{ChannelSample, ContactEnergy, FemContact};
 

@@ -1,11 +1,19 @@
-//! Save and restore an explicit run's dynamic state, contact included (see
-//! [`crate::fem::state_io`]), in one layout for every element kind: build the solver from
-//! the same inputs, call [`Explicit::restore_state`], and the run continues bitwise where it
-//! was saved.
+//! Save and restore an explicit run's dynamic state, contact included, in the one
+//! checkpoint format of demfem ([`crate::state_io`], kind `fem`) and in one layout for every
+//! element kind: build the solver from the same inputs, call [`Explicit::restore_state`],
+//! and the run continues bitwise where it was saved.
+//!
+//! Sections, in order, per node of `D` degrees of freedom (tets 3: m; shells 6: m and rad):
+//! `u` (displacement), `v` (its rate, per s), `f_int`, `f_damp`, `f_ext`, `f_total_prev`,
+//! `f_damp_prev` (nodal forces, N and N m), `du_prev` (last increment), `extra_loads` (N);
+//! `f_contact` (3-vectors, N); `clock` (time and step, s); `steps` (u64); `energy` (time s,
+//! then kinetic, internal, external work, damping work, initial energy, J) and
+//! `energy_history` (6 per report); `has_contact` (u64 0 or 1), then the contact model's
+//! sections (`contact.*`, `fem/contact/state.rs`).
 
 use crate::error::{DemfemError, Result};
 use crate::fem::element_set::ElementSet;
-use crate::fem::state_io::{StateReader, StateWriter};
+use crate::state_io::{StateKind, StateReader, StateWriter};
 
 use super::{EnergyReport, Explicit};
 
@@ -35,7 +43,7 @@ impl<E: ElementSet<D>, const D: usize> Explicit<E, D> {
     /// The dynamic state as bytes: displacements, velocities, the force and work memory of
     /// the integrator, time, steps, energies, and the contact model's state.
     pub fn save_state(&self) -> Vec<u8> {
-        let mut w = StateWriter::new();
+        let mut w = StateWriter::new(StateKind::Fem);
         w.vecs("u", &self.u);
         w.vecs("v", &self.v);
         w.vecs("f_int", &self.f_int);
@@ -62,7 +70,7 @@ impl<E: ElementSet<D>, const D: usize> Explicit<E, D> {
     /// mesh, material, settings and contact. A state of another model (other sizes, another
     /// step, contact present or not) is refused and nothing changes.
     pub fn restore_state(&mut self, bytes: &[u8]) -> Result<()> {
-        let mut r = StateReader::new(bytes)?;
+        let mut r = StateReader::new(bytes, StateKind::Fem)?;
         let n = self.u.len();
         let u = r.vecs("u", Some(n))?;
         let v = r.vecs("v", Some(n))?;
