@@ -218,7 +218,7 @@ def _period_check(events: np.ndarray, hazard: np.ndarray, inside: np.ndarray,
             f"such periods (jams) being rare: {d.n_periods} periods without one bound them "
             f"only to at most {d.unseen_bound:.0%} of the periods ({d.confidence:.0%}, "
             "one-sided); on the default table a 62-s run had one in 30 periods, and it "
-            "raised the hourly number threefold (docs/uncertainty.md).")
+            "raised the hourly number 2.7-fold (docs/uncertainty.md).")
     return doc
 
 

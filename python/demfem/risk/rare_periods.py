@@ -5,8 +5,8 @@ The interval over gate periods treats the periods as exchangeable draws of one d
 On the table that holds between ordinary periods (their hazard totals scatter by a
 coefficient of variation of about 0.2 on the default table) but not for rare events of
 another kind: a cartridge squeezed between the oscillating gate and a side wall (a *jam*)
-loads it quasi-statically at about 100 N for a whole stroke, and its one period carried 70
-times the median period's hazard and about 70 % of a 62-s run's (``docs/uncertainty.md``,
+loads it quasi-statically at about 100 N for a whole stroke, and its one period carried 64
+times the median period's hazard and about 68 % of a 62-s run's (``docs/uncertainty.md``,
 ``benches/interval_coverage.py``). Such a period is not one more draw of the ordinary
 scatter, and a window that holds one, or holds none, cannot say from its few periods how
 often they happen.
@@ -14,8 +14,8 @@ often they happen.
 **The check.** With Y_b the hazard totals of the window's n whole periods:
 
 * a period *dominates* when Y_b > ``ratio`` × median(Y) (default 5: with the ordinary
-  scatter's CV of 0.2 a period above 1.6 × the median is already rare; a factor of 5 is far
-  outside it and far below a jam's 70);
+  scatter's CV of 0.25 a period above 1.9 × the median is already rare; a factor of 5 is far
+  outside it and far below a jam's 64);
 * with such a period, its share Y_b / Σ Y and its place in time are reported, and the
   number is flagged: one event carries it, the interval is no statement about how often such
   events happen;
