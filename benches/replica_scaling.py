@@ -13,7 +13,10 @@ written to ``docs/data/replica_scaling.json`` with every repeat, each replica's 
 time (CPU far below wall: other jobs held the cores), the share of a core a busy loop got
 just before each set, the machine and its load.
 
-    python benches/replica_scaling.py --replicas 6 --duration 0.2 --reps 3
+    python benches/replica_scaling.py --replicas 6 --duration 2.0 --reps 3
+
+Beside it, the machine's own ceiling: two busy processes' throughput over one
+(:func:`machine_ceiling`), which no number of workers can beat.
 
 The replicas are a small table (``--spheres`` cartridges) so that a repeat takes seconds; a
 replica of the default job is minutes, over which the per-replica overhead (worker start,
@@ -43,6 +46,33 @@ def cpu_share(seconds: float = 1.0) -> float:
         for i in range(10_000):
             x += i
     return (time.process_time() - c0) / (time.perf_counter() - t0)
+
+
+def _spin(n: int) -> int:
+    """A pure-CPU loop (no memory traffic to speak of), for :func:`machine_ceiling`."""
+    s = 0
+    for i in range(n):
+        s += i * i
+    return s
+
+
+def machine_ceiling(n: int = 20_000_000, reps: int = 3) -> float:
+    """Throughput of two busy processes at once over one alone (median of ``reps``): what this
+    machine's two cores deliver to any perfectly parallel work. 2.0 on two independent idle
+    cores; less where the two virtual CPUs share a physical core or a power budget."""
+    import multiprocessing as mp
+
+    ratios = []
+    with mp.Pool(2) as pool:
+        pool.map(_spin, [1000, 1000])
+        for _ in range(reps):
+            t0 = time.perf_counter()
+            _spin(n)
+            one_s = time.perf_counter() - t0
+            t0 = time.perf_counter()
+            pool.map(_spin, [n, n])
+            ratios.append(2.0 * one_s / (time.perf_counter() - t0))
+    return statistics.median(ratios)
 
 
 def _warm() -> None:
@@ -110,6 +140,7 @@ def main() -> None:
                       f"and imports {r['startup_and_imports_s']:.1f} s before; CPU "
                       f"{r['busy_fraction']:.0%} of the workers' wall; a busy loop got "
                       f"{share:.0%} of a core just before)", flush=True)
+    ceiling = machine_ceiling()
     same = len({r["events"] for rs in runs.values() for r in rs}) == 1
     rate = {w: statistics.median(r["events_per_wall_s"] for r in rs) for w, rs in runs.items()}
     cold = {w: statistics.median(r["events_per_wall_s_with_startup"] for r in rs)
@@ -130,6 +161,8 @@ def main() -> None:
         "speedup_2_over_1": speedup,
         "speedup_2_over_1_with_startup": cold[2] / cold[1], "efficiency": speedup / 2.0, "target_efficiency": 0.8,
         "target_met": bool(speedup / 2.0 >= 0.8),
+        "machine_two_process_ceiling": ceiling,
+        "share_of_machine_ceiling": speedup / ceiling,
         "same_numbers_on_1_and_2_workers": same,
         "runs": {str(w): rs for w, rs in runs.items()},
         "machine": {"cpu_count": os.cpu_count(), "platform": platform.platform(),
@@ -141,7 +174,9 @@ def main() -> None:
     Path(a.out).write_text(json.dumps(result, indent=1) + "\n", encoding="utf-8")
     print(f"events per wall-second: 1 worker {rate[1]:.1f}, 2 workers {rate[2]:.1f}: "
           f"speedup {speedup:.2f} = {speedup / 2:.0%} of 2 (target 80 %); with start-up "
-          f"{cold[1]:.1f} and {cold[2]:.1f}; same numbers on both: {same}; written {a.out}")
+          f"{cold[1]:.1f} and {cold[2]:.1f}; same numbers on both: {same}; two busy loops "
+          f"get {ceiling:.2f}x one on this machine, so the replicas reach "
+          f"{speedup / ceiling:.0%} of what its two cores deliver; written {a.out}")
 
 
 if __name__ == "__main__":
