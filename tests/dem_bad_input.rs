@@ -73,7 +73,15 @@ fn contact_laws_stay_finite_at_extreme_inputs() {
     assert!((e - 1.25e-40).abs() < 1e-52, "{e}");
     assert_eq!(tsuji_restitution(1e20, ForceClamp::None), 0.0);
     // k_R = 1e-300 with k_H = 1 gave NaN: F ≈ k_R δ
-    let law = NormalLaw::HertzReissner { k_h: 1.0, k_r: 1e-300 }.validated().unwrap();
+    let law = NormalLaw::HertzReissner {
+        k_h: 1.0,
+        k_r: 1e-300,
+    }
+    .validated()
+    .unwrap();
     let (f, k) = law.force_and_stiffness(1e-3);
-    assert!(f.is_finite() && k.is_finite() && (f / 1e-303 - 1.0).abs() < 1e-6, "{f} {k}");
+    assert!(
+        f.is_finite() && k.is_finite() && (f / 1e-303 - 1.0).abs() < 1e-6,
+        "{f} {k}"
+    );
 }

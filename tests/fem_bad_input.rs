@@ -2,7 +2,9 @@
 //! small the mesh would exhaust memory, sliver or near-degenerate elements in the explicit
 //! solver, and two different prescriptions of one degree of freedom.
 
-use demfem::fem::mesh::{ball_tet_mesh, box_tet_mesh, AxisymmetricProfile, TetMesh, MAX_TET_ELEMENTS};
+use demfem::fem::mesh::{
+    ball_tet_mesh, box_tet_mesh, AxisymmetricProfile, TetMesh, MAX_TET_ELEMENTS,
+};
 use demfem::fem::{
     ExplicitConfig, ExplicitSolver, LinearElastic, LoadHistory, Prescribed, PrescribedKind,
 };
@@ -17,13 +19,23 @@ fn tiny_target_size_is_refused_before_meshing() {
     let p = AxisymmetricProfile::default_cartridge();
     let t = std::time::Instant::now();
     let err = p.tet_mesh(48, 2, 1e-9).unwrap_err();
-    assert!(t.elapsed().as_secs_f64() < 1.0, "refused only after {:?}", t.elapsed());
+    assert!(
+        t.elapsed().as_secs_f64() < 1.0,
+        "refused only after {:?}",
+        t.elapsed()
+    );
     assert!(matches!(err, DemfemError::InvalidParameter { .. }));
     let msg = err.to_string();
-    assert!(msg.contains("target_size") && msg.contains("max_elements"), "{msg}");
+    assert!(
+        msg.contains("target_size") && msg.contains("max_elements"),
+        "{msg}"
+    );
     // the estimate is exact for a mesh that is built
     let rm = p.tet_mesh(24, 1, 1e-3).unwrap();
-    assert_eq!(p.tet_mesh_element_count(24, 1, 1e-3), rm.mesh.n_elements() as f64);
+    assert_eq!(
+        p.tet_mesh_element_count(24, 1, 1e-3),
+        rm.mesh.n_elements() as f64
+    );
     // a custom limit just below the count refuses, at the count accepts
     let n = rm.mesh.n_elements();
     assert!(p.tet_mesh_limited(24, 1, 1e-3, n - 1).is_err());
@@ -47,7 +59,10 @@ fn sliver_element_is_refused_by_the_explicit_solver() {
     let err = ExplicitSolver::new(&mesh, ExplicitConfig::new(glass())).unwrap_err();
     let msg = err.to_string();
     assert!(matches!(err, DemfemError::InvalidParameter { .. }), "{msg}");
-    assert!(msg.contains("mesh") && msg.contains("element 0") && msg.contains("dihedral"), "{msg}");
+    assert!(
+        msg.contains("mesh") && msg.contains("element 0") && msg.contains("dihedral"),
+        "{msg}"
+    );
 }
 
 #[test]
@@ -57,13 +72,21 @@ fn near_degenerate_volume_is_refused_by_the_explicit_solver() {
     let mut mesh = box_tet_mesh(1.0, 1.0, 1.0, 1, 1, 1).unwrap();
     let base = mesh.nodes.len();
     let s = 1e-5; // volume ~1e-16 of the others
-    mesh.nodes.extend([[2.0, 0.0, 0.0], [2.0 + s, 0.0, 0.0], [2.0, s, 0.0], [2.0, 0.0, s]]);
+    mesh.nodes.extend([
+        [2.0, 0.0, 0.0],
+        [2.0 + s, 0.0, 0.0],
+        [2.0, s, 0.0],
+        [2.0, 0.0, s],
+    ]);
     mesh.tets.push([base, base + 1, base + 2, base + 3]);
     mesh.validate().unwrap();
     let err = ExplicitSolver::new(&mesh, ExplicitConfig::new(glass())).unwrap_err();
     let msg = err.to_string();
     assert!(msg.contains("mesh") && msg.contains("volume"), "{msg}");
-    assert!(msg.contains(&format!("element {}", mesh.tets.len() - 1)), "{msg}");
+    assert!(
+        msg.contains(&format!("element {}", mesh.tets.len() - 1)),
+        "{msg}"
+    );
 }
 
 #[test]
@@ -92,11 +115,17 @@ fn two_prescriptions_of_one_dof_are_refused() {
     s.set_prescribed(&[d(0, 2, 0.0), d(0, 2, 0.0)], LoadHistory::Constant)
         .unwrap();
     let err = s
-        .set_prescribed(&[d(0, 2, 0.0), d(1, 0, 0.0), d(0, 2, 1e-3)], LoadHistory::Constant)
+        .set_prescribed(
+            &[d(0, 2, 0.0), d(1, 0, 0.0), d(0, 2, 1e-3)],
+            LoadHistory::Constant,
+        )
         .unwrap_err();
     let msg = err.to_string();
     assert!(matches!(err, DemfemError::InvalidParameter { .. }), "{msg}");
-    assert!(msg.contains("prescribed") && msg.contains("node 0 component 2"), "{msg}");
+    assert!(
+        msg.contains("prescribed") && msg.contains("node 0 component 2"),
+        "{msg}"
+    );
     let v = Prescribed {
         node: 3,
         component: 1,

@@ -101,7 +101,8 @@ fn impact(r: f64, n: usize, v: f64, scale: f64, two_balls: bool) -> Impact {
     let reduced = s.dt_limit() < dt_free;
     let dt_ok = s.dt() <= s.dt_limit();
     let p0 = total_momentum(&s);
-    let e0 = 0.5 * s.mass().iter().map(|m| m * v * v).sum::<f64>() * if two_balls { 0.25 } else { 1.0 };
+    let e0 =
+        0.5 * s.mass().iter().map(|m| m * v * v).sum::<f64>() * if two_balls { 0.25 } else { 1.0 };
     // Run for twice the Hertz duration (closed form for the configuration).
     let m = mat.density * 4.0 / 3.0 * std::f64::consts::PI * r * r * r;
     let nu2 = 1.0 - mat.poisson_ratio * mat.poisson_ratio;
@@ -144,7 +145,12 @@ fn impact(r: f64, n: usize, v: f64, scale: f64, two_balls: bool) -> Impact {
     } else {
         0.0
     };
-    println!("  dt {:.3e} s (limit {:.3e}, without contact {:.3e}), {steps} steps", s.dt(), s.dt_limit(), dt_free);
+    println!(
+        "  dt {:.3e} s (limit {:.3e}, without contact {:.3e}), {steps} steps",
+        s.dt(),
+        s.dt_limit(),
+        dt_free
+    );
     let bits = s
         .displacement()
         .iter()
@@ -177,7 +183,12 @@ fn elastic_ball_on_a_rigid_plane_follows_hertz_impact() {
     assert!(ef.abs() < 0.16, "peak force off Hertz by {ef}");
     assert!(et.abs() < 0.10, "contact duration off Hertz by {et}");
     assert!(out.dt_ok && out.reduced);
-    assert!(out.balance < 0.01 * out.e0, "contact bookkeeping {} J of {} J", out.balance, out.e0);
+    assert!(
+        out.balance < 0.01 * out.e0,
+        "contact bookkeeping {} J of {} J",
+        out.balance,
+        out.e0
+    );
 }
 
 #[test]
@@ -194,8 +205,17 @@ fn two_equal_balls_head_on_follow_hertz_and_conserve_momentum() {
     // 8 cells per radius: linear tets are stiff, the filtered peak is ~9 % above Hertz.
     assert!(ef.abs() < 0.16, "peak force off Hertz by {ef}");
     assert!(et.abs() < 0.10, "contact duration off Hertz by {et}");
-    assert!(out.momentum_error < 1e-12, "momentum drift {}", out.momentum_error);
-    assert!(out.balance < 0.01 * out.e0, "contact bookkeeping {} J of {} J", out.balance, out.e0);
+    assert!(
+        out.momentum_error < 1e-12,
+        "momentum drift {}",
+        out.momentum_error
+    );
+    assert!(
+        out.balance < 0.01 * out.e0,
+        "contact bookkeeping {} J of {} J",
+        out.balance,
+        out.e0
+    );
 }
 
 #[test]
@@ -229,7 +249,12 @@ fn contact_is_bitwise_identical_on_one_and_two_threads() {
 fn block(pull: f64, belt: f64, mu: f64, duration: f64) -> (ExplicitSolver, f64) {
     let mat = soft();
     let a = 0.01;
-    let mesh = place(&box_tet_mesh(a, a, a, 3, 3, 3).unwrap(), I3, [0.0, 0.0, 1e-9]).unwrap();
+    let mesh = place(
+        &box_tet_mesh(a, a, a, 3, 3, 3).unwrap(),
+        I3,
+        [0.0, 0.0, 1e-9],
+    )
+    .unwrap();
     let n = mesh.nodes.len();
     let mut cfg = ExplicitConfig::new(mat);
     cfg.rayleigh_beta = 2e-5; // damps the penalty's vertical bounce, not rigid motion
@@ -265,7 +290,12 @@ fn block(pull: f64, belt: f64, mu: f64, duration: f64) -> (ExplicitSolver, f64) 
 
 fn mean_velocity_x(s: &ExplicitSolver) -> f64 {
     let m: f64 = s.mass().iter().sum();
-    s.mass().iter().zip(s.velocity()).map(|(mi, v)| mi * v[0]).sum::<f64>() / m
+    s.mass()
+        .iter()
+        .zip(s.velocity())
+        .map(|(mi, v)| mi * v[0])
+        .sum::<f64>()
+        / m
 }
 
 #[test]
@@ -301,7 +331,10 @@ fn a_block_on_a_belt_slides_until_it_moves_with_the_belt_and_friction_work_close
         e.rigid_work,
         m * vb * vb
     );
-    assert!((v / vb - 1.0).abs() < 0.02, "block at {v} m/s on a {vb} m/s belt");
+    assert!(
+        (v / vb - 1.0).abs() < 0.02,
+        "block at {v} m/s on a {vb} m/s belt"
+    );
     assert!((e.friction_work / (0.5 * m * vb * vb) - 1.0).abs() < 0.05);
     assert!((e.rigid_work / (m * vb * vb) - 1.0).abs() < 0.05);
 }
@@ -315,7 +348,11 @@ fn no_tension_springs_push_and_never_pull() {
         rest_length: 0.01,
     };
     let (f, e) = s.force([0.008, 0.0, 0.0]);
-    assert!((f[0] - 0.2).abs() < 1e-12 && f[1] == 0.0 && (e - 0.5 * 100.0 * 0.002 * 0.002).abs() < 1e-15);
+    assert!(
+        (f[0] - 0.2).abs() < 1e-12
+            && f[1] == 0.0
+            && (e - 0.5 * 100.0 * 0.002 * 0.002).abs() < 1e-15
+    );
     for x in [0.01, 0.0100001, 0.02, 1.0] {
         let (f, e) = s.force([x, 0.0, 0.0]);
         assert_eq!(f, [0.0; 3]);
@@ -326,7 +363,14 @@ fn no_tension_springs_push_and_never_pull() {
     let mesh = box_tet_mesh(0.01, 0.01, 0.01, 1, 1, 1).unwrap();
     let n = mesh.nodes.len();
     let mut solver = ExplicitSolver::new(&mesh, ExplicitConfig::new(mat)).unwrap();
-    let mut c = FemContact::new(&mesh, &vec![0; n], &vec![0; n], &mat, ContactSettings::default()).unwrap();
+    let mut c = FemContact::new(
+        &mesh,
+        &vec![0; n],
+        &vec![0; n],
+        &mat,
+        ContactSettings::default(),
+    )
+    .unwrap();
     c.add_springs(&[NoTensionSpring {
         node: 0,
         anchor: [-0.001, 0.0, 0.0],
@@ -334,7 +378,9 @@ fn no_tension_springs_push_and_never_pull() {
         rest_length: 0.002,
     }])
     .unwrap();
-    solver.set_initial_velocity(&vec![[0.5, 0.0, 0.0]; n]).unwrap();
+    solver
+        .set_initial_velocity(&vec![[0.5, 0.0, 0.0]; n])
+        .unwrap();
     solver.set_contact(c).unwrap();
     let mut pulled = false;
     for _ in 0..2000 {
@@ -361,9 +407,21 @@ fn bad_contact_input_is_refused_with_the_field_named() {
             .to_string()
     };
     let d = ContactSettings::default();
-    assert!(bad(ContactSettings { friction: -0.1, ..d }).contains("friction"));
-    assert!(bad(ContactSettings { friction: f64::NAN, ..d }).contains("friction"));
-    assert!(bad(ContactSettings { penalty_scale: 0.0, ..d }).contains("penalty_scale"));
+    assert!(bad(ContactSettings {
+        friction: -0.1,
+        ..d
+    })
+    .contains("friction"));
+    assert!(bad(ContactSettings {
+        friction: f64::NAN,
+        ..d
+    })
+    .contains("friction"));
+    assert!(bad(ContactSettings {
+        penalty_scale: 0.0,
+        ..d
+    })
+    .contains("penalty_scale"));
     let mut c = FemContact::new(&mesh, &vec![0; n], &vec![0; n], &mat, d).unwrap();
     let e = c
         .add_springs(&[NoTensionSpring {
@@ -384,4 +442,3 @@ fn bad_contact_input_is_refused_with_the_field_named() {
     let e = s.set_contact(c).unwrap_err().to_string();
     assert!(e.contains("overlaps") && e.contains("body"), "{e}");
 }
-

@@ -93,7 +93,10 @@ pub(crate) fn step_count_arg(n: &Bound<'_, PyAny>) -> PyResult<i64> {
     match n.extract::<i64>() {
         Ok(v) => Ok(v),
         Err(e) if n.is_instance_of::<pyo3::types::PyInt>() => {
-            let shown = n.repr().map(|r| r.to_string()).unwrap_or_else(|_| "?".into());
+            let shown = n
+                .repr()
+                .map(|r| r.to_string())
+                .unwrap_or_else(|_| "?".into());
             drop(e);
             Err(invalid("n", &shown, "a whole number of steps below 2^63"))
         }

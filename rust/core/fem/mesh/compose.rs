@@ -13,7 +13,11 @@ use super::{box_tet_mesh, TetMesh};
 pub fn ball_tet_mesh(radius: f64, n: usize) -> Result<TetMesh> {
     check_positive("radius", radius)?;
     if n == 0 || n > 200 {
-        return Err(DemfemError::invalid("n", n as f64, "an integer in [1, 200]"));
+        return Err(DemfemError::invalid(
+            "n",
+            n as f64,
+            "an integer in [1, 200]",
+        ));
     }
     // Half the cube's cells form a core cube of half-side 0.35 R; the outer shell of cells
     // is blended from the core's faces onto the sphere, so no cell has three faces on it.
@@ -25,7 +29,11 @@ pub fn ball_tet_mesh(radius: f64, n: usize) -> Result<TetMesh> {
         let p = [x[0] - 1.0, x[1] - 1.0, x[2] - 1.0];
         let s = p[0].abs().max(p[1].abs()).max(p[2].abs());
         if s <= CORE {
-            *x = [p[0] * radius * CORE_SIZE / CORE, p[1] * radius * CORE_SIZE / CORE, p[2] * radius * CORE_SIZE / CORE];
+            *x = [
+                p[0] * radius * CORE_SIZE / CORE,
+                p[1] * radius * CORE_SIZE / CORE,
+                p[2] * radius * CORE_SIZE / CORE,
+            ];
             continue;
         }
         let q = [p[0] / s, p[1] / s, p[2] / s];

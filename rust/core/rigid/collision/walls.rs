@@ -72,7 +72,13 @@ impl PolygonWall {
 
     /// The polygon at its reference position: vertices (m, boundary order), unit normal and
     /// inward in-plane edge normals.
-    pub fn parts(&self) -> (&[crate::geometry::Vec3], crate::geometry::Vec3, &[crate::geometry::Vec3]) {
+    pub fn parts(
+        &self,
+    ) -> (
+        &[crate::geometry::Vec3],
+        crate::geometry::Vec3,
+        &[crate::geometry::Vec3],
+    ) {
         match &self.shape {
             WallShape::Polygon {
                 vertices,
