@@ -105,17 +105,21 @@ def plot_force_vs_modulus(table: CalibrationTable, path: "str | Path",
     return out
 
 
-def calibration_report(v_rel: float = 0.2) -> str:
-    """The equivalent sphere of the default cartridge, as text: glass volume (mm^3), mass (g),
-    centre of mass (mm), inertia (kg m^2), sphere diameter (mm), Reissner stiffness (N/m),
-    Hertz contact time at ``v_rel`` (m/s) and the Rayleigh time step (s)."""
-    cart = Cartridge()
+def calibration_report(v_rel: float = 0.2, cartridge: "Optional[Cartridge]" = None) -> str:
+    """The equivalent sphere of ``cartridge`` (default: the default 3 mL cartridge), as text:
+    glass volume (mm^3), mass (g), centre of mass (mm), inertia (kg m^2), sphere diameter (mm),
+    Reissner stiffness (N/m), Hertz contact time at ``v_rel`` (m/s) and the Rayleigh time step
+    (s)."""
+    cart = Cartridge() if cartridge is None else cartridge
     sphere = cart.equivalent_sphere()
     body = ContactBody.from_cartridge(cart)
     mp = cart.mass_properties()
     m = cart.material
+    what = ("Default cartridge (3 mL, ISO 13926-1 style)" if cart == Cartridge() else
+            f"The scene's cartridge ({cart.body_outer_diameter * 1e3:g} mm x "
+            f"{cart.length * 1e3:g} mm, wall {cart.wall_thickness * 1e3:g} mm)")
     return "\n".join([
-        f"Default cartridge (3 mL, ISO 13926-1 style), glass: {m.name}",
+        f"{what}, glass: {m.name}",
         f"  glass volume        {cart.glass_volume * 1e9:10.1f} mm^3",
         f"  mass                {cart.mass * 1e3:10.3f} g",
         f"  centre of mass z    {mp.center_of_mass[2] * 1e3:10.2f} mm from the open end",

@@ -173,8 +173,10 @@ def _run(folder, table, duration: float, sample_interval: float, threads: int, v
 
     # 1. calibration
     log("== 1. calibration: the equivalent sphere ==")
-    log(calibration_report(v_rel))
-    cal = force_vs_modulus(Cartridge(), np.logspace(7, 11, 9), v_rel)
+    # the scene's cartridge (a table's [cartridge]); a mesh table's spheres are given directly
+    cartridge = getattr(table, "cartridge", None) or Cartridge()
+    log(calibration_report(v_rel, cartridge))
+    cal = force_vs_modulus(cartridge, np.logspace(7, 11, 9), v_rel)
     log(f"\nMaximum contact force, two cartridges at v_rel = {v_rel:g} m/s (Fig. 3 analogue):")
     log(cal.format())
     cal_csv, cal_png = write_calibration(out, cal)

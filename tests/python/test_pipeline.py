@@ -129,3 +129,35 @@ def test_bad_input_names_the_field(tmp_path, field, kwargs):
 def test_the_command_reports_bad_input(tmp_path, capsys):
     assert main(["run", "--E", "-1", "--duration", "0.01", "--out", str(tmp_path)]) == 2
     assert "young_modulus" in capsys.readouterr().err
+
+
+def test_the_calibration_is_of_the_scene_s_cartridge(tmp_path):
+    """`demfem run` calibrates the cartridge its scene carries (a `[cartridge]` table), not
+    the default one."""
+    from demfem.calibration import calibration_report
+    from demfem.cartridge import Cartridge
+
+    small = Cartridge(body_outer_diameter=10.0e-3, wall_thickness=0.9e-3)
+    text = calibration_report(0.2, small)
+    assert "The scene's cartridge (10 mm x 64 mm, wall 0.9 mm)" in text
+    assert f"{small.mass * 1e3:10.3f} g" in text and small.mass < Cartridge().mass
+    assert calibration_report(0.2).startswith("Default cartridge (3 mL")
+    table = AccumulationTable(width=0.1, length=0.1, tilted_wall_length=0.05, n_spheres=30,
+                              cartridge=small)
+    lines = []
+    run_pipeline(tmp_path, duration=0.01, sample_interval=0.005, scene=table, log=lines.append)
+    log = "\n".join(lines)
+    assert "The scene's cartridge (10 mm x 64 mm, wall 0.9 mm)" in log
+    assert f"{small.mass * 1e3:10.3f} g" in log
+    # calibration.csv is the small cartridge's force table, not the default's
+    from demfem.calibration import force_vs_modulus
+
+    with open(tmp_path / "calibration.csv") as fh:
+        row = next(csv.DictReader(fh))
+    e = float(row["E_Pa"])
+    k = force_vs_modulus(small, [e], 0.2)
+    mine = float(k.forces[list(k.models).index("hertz_reissner"), 0])
+    d = force_vs_modulus(Cartridge(), [e], 0.2)
+    theirs = float(d.forces[list(d.models).index("hertz_reissner"), 0])
+    assert float(row["F_hertz_reissner_N"]) == pytest.approx(mine, rel=1e-6)
+    assert abs(mine - theirs) > 1e-3 * theirs
