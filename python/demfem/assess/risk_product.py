@@ -12,8 +12,8 @@ from typing import Any, Optional
 
 import numpy as np
 
-from demfem.assess.risk_stage import (event_hazard, event_probabilities, passage_risk,
-                                      risk_map, steady_state, worst_events)
+from demfem.assess.risk_stage import (event_hazard, event_probabilities, partner_name,
+                                      passage_risk, risk_map, steady_state, worst_events)
 
 __all__ = ["risk_document", "VTK_EVENTS"]
 
@@ -195,9 +195,8 @@ def _period_check(events: np.ndarray, hazard: np.ndarray, inside: np.ndarray,
         a, b = d.largest_window_s
         sel = np.flatnonzero(inside & (events["time"] >= a) & (events["time"] < b))
         k = int(sel[np.argmax(hazard[sel])])
-        wall = int(events["wall"][k])
         who = ("another cartridge" if int(events["partner"][k]) == 0 else
-               (wall_names[wall].replace("_", " ") if 0 <= wall < len(wall_names) else "a wall"))
+               partner_name(events[k], wall_names).replace("_", " "))
         share = d.largest_share
         doc["largest_event"] = {"event": k, "time_s": float(events["time"][k]), "with": who,
                                 "force_N": float(stress["force_N"][k]),

@@ -41,7 +41,7 @@ from demfem.risk.fatigue import half_sine_sn_factor
 
 __all__ = ["event_probabilities", "surface_probability",
            "equivalent_stress", "passage_risk", "event_hazard", "steady_state",
-           "worst_events", "risk_map"]
+           "worst_events", "partner_name", "risk_map"]
 
 def surface_probability(surface: SurfaceStrength, stress: np.ndarray,
                         area: np.ndarray) -> np.ndarray:
@@ -219,6 +219,15 @@ def steady_state(events: np.ndarray, p_event: np.ndarray, window: tuple[float, f
     return out
 
 
+def partner_name(event: Any, wall_names: Sequence[str] = ()) -> str:
+    """Who an event's cartridge met: ``cartridge j``, or the wall by its name in
+    ``wall_names`` (the run's walls by index; ``wall`` when the index is not among them)."""
+    w = int(event["wall"])
+    if int(event["partner"]) == 0:
+        return f"cartridge {int(event['j'])}"
+    return wall_names[w] if 0 <= w < len(wall_names) else "wall"
+
+
 def worst_events(events: np.ndarray, p: dict[str, np.ndarray], stress: dict[str, np.ndarray],
                  window: tuple[float, float], count: int = 10,
                  wall_names: Sequence[str] = ()) -> list[dict[str, Any]]:
@@ -231,11 +240,8 @@ def worst_events(events: np.ndarray, p: dict[str, np.ndarray], stress: dict[str,
     rows = []
     for k in order:
         e = events[k]
-        w = int(e["wall"])
-        with_ = (f"cartridge {int(e['j'])}" if int(e["partner"]) == 0 else
-                 (wall_names[w] if 0 <= w < len(wall_names) else "wall"))
         rows.append({"event": int(k), "i": int(e["i"]), "j": int(e["j"]),
-                     "partner": PARTNERS[int(e["partner"])], "with": with_,
+                     "partner": PARTNERS[int(e["partner"])], "with": partner_name(e, wall_names),
                      "time_s": float(e["time"]),
                      "x_m": float(e["x"]), "y_m": float(e["y"]),
                      "normal_speed_m_per_s": float(e["normal_speed"]),
