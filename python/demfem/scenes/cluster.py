@@ -21,6 +21,19 @@ moves towards +x), y across it, z up; the belt is the rigid plane z = 0. Top vie
   and ``v3`` (m/s) along the headings ``direction_2_deg`` and ``direction_3_deg`` (degrees
   from +x, counter-clockwise from above). Heading 0° for 2 and -60° for 3 aim straight at 1
   (head-on); any other heading adds a tangential component at impact.
+* Tilt and lift of 2 and 3 (default 0: upright, standing on the belt like the rest):
+  ``tilt_2_deg``, ``tilt_3_deg`` (degrees, in [-10, 10]) turn the cartridge's axis about the
+  horizontal axis perpendicular to its heading (z × heading, right-hand rule): **positive =
+  the top leans forward along the heading, so the top end (the body's shoulder edge) leads
+  and hits 1 first; negative = the top leans back, the open (bottom) end's outer edge leads**.
+  ``offset_2_z``, ``offset_3_z`` (m, in [0, length / 2]) lift the cartridge: its lowest glass
+  point is ``lift + offset`` above the belt (lowering into the belt is refused). A tilted or
+  lifted cartridge is then moved along its site direction until the closest approach of its
+  outer surface to 1's is ``impact_gap`` (measured radially on the exact outer envelope at
+  the mesh's node columns, :mod:`demfem.fem.cluster_placement`); it keeps its initial
+  velocity (V along its heading, horizontal: it translates, no spin). A tilt or lift that
+  makes it overlap any other cartridge at t = 0 is refused, naming the field.
+  :meth:`CartridgeCluster.first_contact` gives where on 1 each hitter touches first.
 * Built-in load cases (paper, Fig. 10a,b): ``max`` V2 = 0.18, V3 = 0.12 m/s and ``avg`` V2 =
   0.05, V3 = 0.025 m/s, both head-on: 2 moves along the belt straight at 1, 3 comes from
   the site 60° off the belt direction straight at 1 (heading -60°). The paper took the
@@ -110,7 +123,15 @@ _UNITS = {
     "penalty_scale": "contact penalty scale (1 = OpenRadioss default)",
     "mass_scaling_dt": "s, raise masses so the step is at least this; 0 = none",
     "coordination": "touching neighbours of 1 in the DEM case it stands for (information)",
+    "tilt_2_deg": "degrees in [-10, 10] about z x heading; + top leads, - bottom leads",
+    "tilt_3_deg": "degrees in [-10, 10] about z x heading; + top leads, - bottom leads",
+    "offset_2_z": "m in [0, length/2], lift of 2 above lift",
+    "offset_3_z": "m in [0, length/2], lift of 3 above lift",
 }
+
+#: The hitters' tilt and lift fields, by cartridge index (0-based: 2 -> 1, 3 -> 2).
+_HITTER_FIELDS = {1: ("tilt_2_deg", "offset_2_z", "direction_2_deg"),
+                  2: ("tilt_3_deg", "offset_3_z", "direction_3_deg")}
 
 
 def _flag(name: str, value: Any) -> bool:
@@ -161,6 +182,10 @@ class CartridgeCluster:
     penalty_scale: float = 1.0
     mass_scaling_dt: float = 0.0
     coordination: int = 6
+    tilt_2_deg: float = 0.0
+    tilt_3_deg: float = 0.0
+    offset_2_z: float = 0.0
+    offset_3_z: float = 0.0
     cartridge: Cartridge = field(default_factory=Cartridge)
 
     def __post_init__(self) -> None:
@@ -219,6 +244,20 @@ class CartridgeCluster:
         check_range("impact_gap", ig, 0.0, self.cartridge.body_outer_diameter)
         if self.v2 == 0 and self.v3 == 0:
             raise InvalidParameterError("invalid v2 = v3 = 0: at least one of 2 and 3 must move")
+        from demfem.fem.cluster_placement import ANY_TILT_LIMIT_DEG
+
+        for name in ("tilt_2_deg", "tilt_3_deg"):
+            object.__setattr__(self, name, check_range(
+                name, getattr(self, name), -ANY_TILT_LIMIT_DEG, ANY_TILT_LIMIT_DEG,
+                lo_open=False, hi_open=False))
+        for name in ("offset_2_z", "offset_3_z"):
+            v = getattr(self, name)
+            if isinstance(v, (int, float)) and not isinstance(v, bool) and v < 0:
+                raise InvalidParameterError(
+                    f"invalid {name} = {v!r}: negative, the cartridge would sink into the belt "
+                    f"(must be in [0, {0.5 * self.cartridge.length:g}] m, a lift)")
+            object.__setattr__(self, name, check_range(
+                name, v, 0.0, 0.5 * self.cartridge.length, lo_open=False, hi_open=False))
         self._check_no_overlap()
 
     # ------------------------------------------------------------------ cases
@@ -292,13 +331,64 @@ class CartridgeCluster:
         """Body outer diameter D, m."""
         return float(self.cartridge.body_outer_diameter)
 
-    def centres(self) -> np.ndarray:
-        """Centres (x, y) of cartridges 1-7 at t = 0, (7, 2) m."""
+    def sites(self) -> np.ndarray:
+        """Site centres (x, y) of cartridges 1-7, (7, 2) m: 1 at the origin, 2 and 3 at
+        ``D + impact_gap``, 4-7 at ``D + touch_gap`` along their site angles."""
         d = self.diameter
         out = np.zeros((7, 2))
         for k, phi in enumerate(SITE_ANGLES_DEG):
             r = d + (self.impact_gap if k < 2 else self.touch_gap)
             out[k + 1] = r * np.array([math.cos(math.radians(phi)), math.sin(math.radians(phi))])
+        return out
+
+    def is_upright(self) -> bool:
+        """True when 2 and 3 stand upright on the belt (no tilt, no offset)."""
+        return not any((self.tilt_2_deg, self.tilt_3_deg, self.offset_2_z, self.offset_3_z))
+
+    def placements(self) -> list:
+        """Placements of 1-7 (:class:`demfem.fem.cluster_placement.Placement`, the glass's
+        own frame: axis z, open end at z = 0) at t = 0: upright at their sites with the open
+        end ``lift`` above the belt, 2 and 3 tilted and lifted as set (module text)."""
+        from demfem.fem.cluster_placement import Placement, place_hitter
+
+        sites = self.sites()
+        out = [Placement(np.eye(3), np.array([x, y, float(self.lift)])) for x, y in sites]
+        for k, (tilt, offset, heading) in _HITTER_FIELDS.items():
+            tilt_v, off_v = getattr(self, tilt), getattr(self, offset)
+            if tilt_v == 0 and off_v == 0:
+                continue
+            try:
+                out[k] = place_hitter(self.cartridge, sites[k], getattr(self, heading), tilt_v,
+                                      float(self.lift) + off_v, float(self.impact_gap),
+                                      self.n_theta(), centre=out[0])
+            except InvalidParameterError as exc:
+                raise InvalidParameterError(
+                    f"invalid {tilt} = {tilt_v!r} with {offset} = {off_v!r}: {exc}") from None
+        return out
+
+    def centres(self) -> np.ndarray:
+        """Positions (x, y) of the open ends' centres of 1-7 at t = 0, (7, 2) m: the sites,
+        except for a tilted or lifted 2 or 3 (moved to keep the start gap)."""
+        if self.is_upright():
+            return self.sites()
+        return np.array([p.translation[:2] for p in self.placements()])
+
+    def first_contact(self) -> dict[str, dict[str, float]]:
+        """Where 2 and 3 are closest to 1 at t = 0 (their first contact when they move
+        straight at it): ``{"2": {"gap_m", "z_m", "theta_deg"}, "3": ...}``, z on 1 from its
+        open end (m), theta the angle around 1 (degrees from +x); the closest of 1's
+        envelope samples, ties averaged (a line contact gives its middle)."""
+        from demfem.fem.cluster_placement import closest_approach
+
+        pl = self.placements()
+        out = {}
+        for k in (1, 2):
+            gap, pts = closest_approach(pl[0], pl[k], self.cartridge, self.n_theta())
+            z = pts[:, 2] - float(self.lift)
+            th = np.degrees(np.arctan2(pts[:, 1], pts[:, 0]))
+            out[str(k + 1)] = {"gap_m": float(gap), "z_m": float(np.mean(z)),
+                               "z_min_m": float(np.min(z)), "z_max_m": float(np.max(z)),
+                               "theta_deg": float(np.mean(th))}
         return out
 
     def velocities(self) -> list[tuple[float, float, float]]:
@@ -310,6 +400,9 @@ class CartridgeCluster:
         return v
 
     def _check_no_overlap(self) -> None:
+        if not self.is_upright():
+            self._check_placed_clearance()
+            return
         c = self.centres()
         d = self.diameter
         for i in range(7):
@@ -319,6 +412,40 @@ class CartridgeCluster:
                     raise InvalidParameterError(
                         f"invalid start positions: cartridges {i + 1} and {j + 1} overlap "
                         f"({dist:.6g} m apart, less than the diameter {d:g} m)")
+
+    def _check_placed_clearance(self) -> None:
+        """Refuse a tilt or lift that makes 2 or 3 overlap another cartridge at t = 0: pairs
+        with a tilted or lifted cartridge by their envelopes' clearance, the others by their
+        centre distance."""
+        from demfem.fem.cluster_placement import ANY_TILT_LIMIT_DEG, clearance, envelope_points
+
+        pl = self.placements()
+        moved = {k for k in (1, 2) if not self._upright_hitter(k)}
+        pts = envelope_points(self.cartridge, self.n_theta())
+        c = self.sites()
+        for i in range(7):
+            for j in range(i + 1, 7):
+                if {i, j} & moved:
+                    gap = clearance(pl[i], pl[j], self.cartridge, self.n_theta(), points=pts)
+                    if gap >= 0.0:
+                        continue
+                    names = " and ".join(f"{f} = {getattr(self, f)!r}"
+                                         for q in sorted({i, j} & moved)
+                                         for f in _HITTER_FIELDS[q][:2])
+                    raise InvalidParameterError(
+                        f"invalid {names}: cartridges {i + 1} and {j + 1} would overlap at "
+                        f"t = 0 (closest approach {gap:.3g} m); tilts must be in "
+                        f"[-{ANY_TILT_LIMIT_DEG:g}, {ANY_TILT_LIMIT_DEG:g}] degrees and leave "
+                        "every pair apart (a smaller tilt, another heading or a lift)")
+                dist = float(np.hypot(*(c[i] - c[j])))
+                if dist < self.diameter * (1.0 - 1e-12):
+                    raise InvalidParameterError(
+                        f"invalid start positions: cartridges {i + 1} and {j + 1} overlap "
+                        f"({dist:.6g} m apart, less than the diameter {self.diameter:g} m)")
+
+    def _upright_hitter(self, k: int) -> bool:
+        tilt, offset, _ = _HITTER_FIELDS[k]
+        return getattr(self, tilt) == 0 and getattr(self, offset) == 0
 
     def n_theta(self) -> int:
         """Divisions around of the meshes: the mesher's default for the element size,
@@ -365,7 +492,10 @@ class CartridgeCluster:
                                       n_theta=n_theta)
             z0 = 0.0
         centres = self.centres()
-        meshes = [base.placed(None, (float(x), float(y), float(self.lift) + z0)) for x, y in centres]
+        # Each glass placement, the mesh's own offset added (a shell's open-end ring carries
+        # half its thickness below its mid-surface nodes).
+        meshes = [base.placed(p.rotation, p.translation + np.array([0.0, 0.0, z0]))
+                  for p in self.placements()]
         regions_1 = (meshes[0].nodes[:, 2] >= self.lift + z0 + 0.5 * c.length).astype(np.int64)
         springs = []
         k_contact = 0.0
