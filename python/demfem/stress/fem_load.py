@@ -31,6 +31,7 @@ __all__ = [
     "contact_side",
     "contact_loads",
     "support_with_inertia_relief",
+    "inertia_relief",
 ]
 
 #: which part of the contact load: the normal pressure or the sliding traction.
@@ -158,9 +159,21 @@ def support_with_inertia_relief(mesh: ResolvedMesh, part: Load, f: np.ndarray
     """Fixed (node, component) pairs, their values (zeros) and the load with the inertia
     relief added: the rigid-body modes the symmetry planes leave free are balanced by
     d'Alembert body forces, then fixed at far-end dofs (whose reactions must then vanish)."""
-    X = mesh.nodes
     planes = _plane_constraints(mesh, part)
     fixed = np.concatenate([np.stack([n, np.full(len(n), c)], -1) for n, c in planes])
+    return inertia_relief(mesh, fixed, f)
+
+
+def inertia_relief(mesh: ResolvedMesh, fixed: np.ndarray, f: np.ndarray
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict[str, float]]:
+    """The inertia relief of a free body whose only supports are the (node, component) pairs
+    ``fixed`` (k, 2; symmetry planes): the load ``f`` (N, 3; N)'s projection on the rigid-body
+    modes those pairs leave free is balanced by the d'Alembert body force −ρ(ä + α × r) (as
+    consistent nodal loads; ρ cancels), and the free modes are then fixed at far dofs (from
+    ``mesh.body.contact_point``) whose reactions must vanish. Returns the fixed pairs (the
+    given ones, then ``info["relief_dofs"]`` more), their values (zeros), the balanced load
+    and ``info`` (``free_rigid_modes``, ``inertia_relief_force_N``, ``relief_dofs``)."""
+    X = mesh.nodes
     modes = _rigid_modes(X)
     Phi = np.stack([m(X) for m in modes], -1)  # (N, 3, 6)
     Cphi = Phi[fixed[:, 0], fixed[:, 1], :]  # (k, 6)

@@ -39,6 +39,8 @@ __all__ = [
     "signed_volume",
     "build_mesh",
     "surface_coordinates",
+    "size_expression",
+    "mesh_stats",
 ]
 
 
@@ -189,9 +191,11 @@ class Grading:
                    0.3 if growth is None else growth, edge_growth=edge_growth)
 
 
-def _size_expression(body: Body, patch: HertzPatch, g: Grading,
-                     opposite: bool) -> str:
-    """The size field as a gmsh MathEval expression (also evaluated with numpy)."""
+def size_expression(body: Body, patch: HertzPatch, g: Grading,
+                    opposite: bool) -> str:
+    """The size field of grading ``g`` (target edge length, m, at (x, y, z) in m) as a gmsh
+    MathEval expression (also evaluated with numpy): graded toward the contact centred at
+    ``body.contact_point`` (its z = 0), its rim and, on a tube, the wall around it."""
     y0 = float(body.contact_point[1])
     yy = "Abs(y)" if opposite else "y"
     a_s, a_z = patch.semi_axis_s, patch.semi_axis_z
@@ -256,7 +260,7 @@ def estimate_elements(body: Body, patch: HertzPatch, grading: Grading,
                       opposite: bool = False, limit: float = math.inf) -> float:
     """Tets a mesh of this grading will have, ≈ 6 ∫ dV / h³, integrated on an octree refined
     until each cell is below the local size (stops early once above ``limit``)."""
-    expr = _size_expression(body, patch, grading, opposite)
+    expr = size_expression(body, patch, grading, opposite)
     lo, hi = _bbox(body)
     span = hi - lo
     n0 = np.maximum(1, np.ceil(span / (span.max() / 4))).astype(int)
@@ -398,7 +402,7 @@ def build_mesh(body: Body, patch: HertzPatch, grading: Optional[Grading] = None,
             f"{g.edge_size!r}, wall_size {g.wall_size!r}, growth {g.growth!r}): about "
             f"{n_est:.3g} elements, above max_elements = {max_elements:.3g}; coarsen the "
             "grading or raise max_elements")
-    expr = _size_expression(body, patch, g, opposite)
+    expr = size_expression(body, patch, g, opposite)
     t0 = time.perf_counter()
     initialized_here = not gmsh.isInitialized()
     if initialized_here:
@@ -516,7 +520,7 @@ def build_mesh(body: Body, patch: HertzPatch, grading: Optional[Grading] = None,
     fi = np.concatenate(inner_f) if inner_f else np.zeros((0, 3 * order), np.int64)
     mesh = ResolvedMesh(body, patch, g, order, X, T.astype(np.int64), fo.astype(np.int64),
                         fi.astype(np.int64), opposite)
-    mesh.stats = _mesh_stats(mesh, qmin, t_mesh, n_est)
+    mesh.stats = mesh_stats(mesh, qmin, t_mesh, n_est)
     return mesh
 
 
@@ -527,8 +531,11 @@ def surface_coordinates(body: Body, X: np.ndarray) -> tuple[np.ndarray, np.ndarr
     return X[:, 0], X[:, 2]
 
 
-def _mesh_stats(mesh: ResolvedMesh, qmin: float, t_mesh: float, n_est: float
-                ) -> dict[str, float]:
+def mesh_stats(mesh: ResolvedMesh, qmin: float, t_mesh: float, n_est: float
+               ) -> dict[str, float]:
+    """Counts and measured edge lengths (m) of a mesh: under the contact and at its rim on
+    ``mesh.outer_faces``, on the tube's inner surface under the load; ``qmin`` (the worst
+    minSICN), the meshing time ``t_mesh`` (s) and the estimated tet count ``n_est`` as given."""
     X, F = mesh.nodes, mesh.outer_faces[:, :3]
     p = mesh.patch
     edges = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])

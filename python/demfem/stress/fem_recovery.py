@@ -40,6 +40,7 @@ __all__ = [
     "surface_fit_stresses",
     "surface_peak",
     "RIM_FOURIER_ORDER",
+    "smooth_rim",
 ]
 
 
@@ -293,7 +294,7 @@ def surface_peak(mesh: ResolvedMesh, faces: np.ndarray, s_normal: np.ndarray,
                  extra_tangential: Optional[np.ndarray] = None) -> SurfacePeak:
     """Peak σ1 over a surface (both z-images of the quarter model; the surface nodes and the
     ``extra_points`` with their stresses — on the rim of an elliptical contact: σ1 along the
-    rim is smoothed by a Fourier series (:func:`_smooth_rim`) and stands for the nodes within
+    rim is smoothed by a Fourier series (:func:`smooth_rim`) and stands for the nodes within
     0.1 a of it) and the effective area ∫ ⟨σ1/σ_max⟩^m dA over the
     whole body (4 images of the quarter surface); σ1 is the largest in-plane principal stress
     (:func:`in_plane_sigma1`), interpolated over each surface triangle with its shape
@@ -342,7 +343,7 @@ def surface_peak(mesh: ResolvedMesh, faces: np.ndarray, s_normal: np.ndarray,
                 rim_phi += [-phi, phi - math.pi]
                 rim_val += [v, v]
     if use_rim:
-        phi_r, smooth = _smooth_rim(np.concatenate(rim_phi), np.concatenate(rim_val))
+        phi_r, smooth = smooth_rim(np.concatenate(rim_phi), np.concatenate(rim_val))
         if smooth > best[0]:
             p = mesh.patch
             x = p.semi_axis_s * math.cos(phi_r)
@@ -371,9 +372,10 @@ def surface_peak(mesh: ResolvedMesh, faces: np.ndarray, s_normal: np.ndarray,
 RIM_FOURIER_ORDER = 8
 
 
-def _smooth_rim(phi: np.ndarray, value: np.ndarray) -> tuple[float, float]:
-    """Least-squares Fourier series (order :data:`RIM_FOURIER_ORDER`) of σ1 along the whole
-    rim (parametric angle φ), and the angle and value of its maximum."""
+def smooth_rim(phi: np.ndarray, value: np.ndarray) -> tuple[float, float]:
+    """Least-squares Fourier series (order :data:`RIM_FOURIER_ORDER`) of σ1 (Pa) along the
+    whole rim of an elliptical contact (parametric angle φ, rad), and the angle (rad) and
+    value (Pa) of its maximum."""
     k = np.arange(1, RIM_FOURIER_ORDER + 1)
     def basis(f: np.ndarray) -> np.ndarray:
         return np.concatenate([np.ones((len(f), 1)), np.cos(np.outer(f, k)),
