@@ -17,6 +17,10 @@ runs it (σ1 of cartridge 1 sampled every ``stress_interval`` = 5 µs, since an 
   inner surface (θ, z) at the snapshot nearest each force peak;
 * ``cluster_sigma1.gif``: the outer-surface σ1 map over time (needs pillow);
 * ``vtk/cluster_NNNN.vtu`` and ``cluster.pvd``: the VTK series (ParaView);
+* ``cluster_submodel.csv`` and the ``submodel`` entry of the summary: σ1 (outer, inner) and
+  effective areas on 1 from the closed-form contact model at the smoothed force histories,
+  per pair and region, and their peaks beside the FEM's zone σ1
+  (:mod:`demfem.fem.cluster_submodel`);
 * ``summary.json``: peaks, wall time, steps, settings (strict JSON).
 
 The folder (:class:`demfem.jobs.OutputFolder`, record ``settings.json``) is locked while the
@@ -579,6 +583,20 @@ def _write_outputs(cluster: CartridgeCluster, data: dict, out: Path, log: Log) -
     else:
         log(gif_note)
 
+    # the closed-form submodel on the force histories (demfem.fem.cluster_submodel)
+    from demfem.fem.cluster_submodel import SUBMODEL_CSV, evaluate_submodel
+
+    sub = evaluate_submodel(cluster, data)
+    write_text_atomic(out / SUBMODEL_CSV, sub.csv_text())
+    written.append(SUBMODEL_CSV)
+    submodel = sub.summary()
+    for p in PAIRS:
+        for r, rn in REGIONS:
+            entry = submodel["pairs"][f"1-{p}_{rn}"]
+            for side in ("outer", "inner"):
+                vals = sig[:, _zone(geo, p, r) & geo[side]]
+                entry[f"fem_zone_{side}_sigma1_Pa"] = float(vals.max()) if vals.size else None
+
     stats = data["stats"]
     k_peak = int(np.argmax(body_max)) if len(body_max) else 0
     summary = {
@@ -597,7 +615,7 @@ def _write_outputs(cluster: CartridgeCluster, data: dict, out: Path, log: Log) -
         "sigma1_body_max_time_s": float(ts[k_peak]) if len(ts) else None,
         "sigma1_zone_max_Pa": {f"1-{p}_{rn}": float(zone_max[(p, r)].max())
                                for p in PAIRS for r, rn in REGIONS},
-        "through_wall": through, "maps": maps, "paper": PAPER_VALUES,
+        "through_wall": through, "maps": maps, "submodel": submodel, "paper": PAPER_VALUES,
         "files": written + ["summary.json", "cluster.pvd", "vtk/"],
         "gif_note": gif_note,
     }
