@@ -204,8 +204,9 @@ def test_material_and_cartridge_are_used():
     ({"friction_coefficient": 2.5}, (1.0, 0.5), "friction_coefficient"),
     ({"geometry": "sphere"}, (1.0,), "geometry"),
     ({"location": "neck"}, (1.0,), "location"),
-    ({"location": "rim"}, (1.0,), "location"),
-    ({"location": "shoulder"}, (1.0,), "location"),
+    ({"location": "rim", "geometry": "parallel", "contact_length": 0.01}, (1.0,), "location"),
+    ({"location": "shoulder", "geometry": "wall", "contact_length": 0.01}, (1.0,),
+     "location"),
     ({"crossing_angle_deg": 0.0}, (1.0,), "crossing_angle_deg"),
     ({"crossing_angle_deg": 120.0}, (1.0,), "crossing_angle_deg"),
     ({"geometry": "parallel"}, (1.0,), "contact_length"),
@@ -236,7 +237,8 @@ def test_bad_input_messages_give_the_range():
         contact_stresses(2e4)
     with pytest.raises(InvalidParameterError, match=r"\[0, 1\].*friction_coefficient"):
         contact_stresses(1.0, 1.5)
-    with pytest.raises(InvalidParameterError, match="no FEM table"):
-        contact_stresses(1.0, location="rim")
+    # rim and shoulder: point contacts only (their factors come from a point-contact FEM)
+    with pytest.raises(InvalidParameterError, match="point contact"):
+        contact_stresses(1.0, location="rim", geometry="parallel", contact_length=0.01)
     # the friction limit may be raised
     assert float(contact_stresses(1.0, 1.5, friction_coefficient=1.6).outer_contact_Pa) > 0

@@ -32,9 +32,13 @@ Assumptions and range (docs/stress.md has the discussion): linear elastic glass,
 (the contact lasts 30–100 µs, the wall's local bending period under the load ≈ 5 µs), the
 contact small against the wall (a < t for the half-space field, a < ℓ for the concentrated
 load), a long straight tube free over the cartridge's body length (no rim, shoulder or free
-ends), full sliding (no stick zone), mid-body (``location = "body"``: no closed form holds near
-the open rim or on the shoulder). Optional flaw-depth correction
-(:mod:`demfem.stress.flaw_depth`).
+ends), full sliding (no stick zone), mid-body (``location = "body"``). Near the open rim and below
+the shoulder (``location = "rim"``, ``"shoulder"``; point contacts only) no closed form holds:
+the global terms (the inner bending tension, the outer bending at the contact edge, the ring
+tension away from it, and their effective areas) are multiplied by factors from a resolved
+FEM of the whole cartridge at the place over the same at mid-body
+(:mod:`demfem.stress.place_factors`), the local contact term kept, and the terms recombined as
+at mid-body. Optional flaw-depth correction (:mod:`demfem.stress.flaw_depth`).
 
 SI units: N, m, Pa, m².
 """
@@ -56,12 +60,15 @@ from demfem.stress.cylinder_load import RHO, line_load_profile, point_load_table
 from demfem.stress.ring import RING_SUPPORTS
 from demfem.stress.shell import characteristic_length
 
-__all__ = ["GEOMETRIES", "LOCATIONS", "ContactStresses", "contact_stresses"]
+__all__ = ["GEOMETRIES", "LOCATIONS", "PLACE_GEOMETRIES", "ContactStresses", "contact_stresses"]
 
 #: Contact geometries (:func:`contact_stresses`).
 GEOMETRIES = ("crossed", "parallel", "wall", "edge")
-#: Places on the cartridge; only "body" has a model today.
+#: Places on the cartridge: mid-body (the closed forms), near the open rim and below the
+#: shoulder (the closed forms times FEM factors, :mod:`demfem.stress.place_factors`).
 LOCATIONS = ("body", "rim", "shoulder")
+#: Geometries the place factors hold for (point contacts).
+PLACE_GEOMETRIES = ("crossed", "edge")
 #: Largest effective friction coefficient Q/F accepted without a ``friction_coefficient``.
 DEFAULT_FRICTION_LIMIT = 1.0
 
@@ -190,8 +197,12 @@ def contact_stresses(normal_force: Any, tangential_force: Any = 0.0, *,
         contact_length: length of a line contact, m, in (0, body length] ("parallel", "wall";
             required there, refused elsewhere).
         location: ``"body"`` (mid-body, away from the rim and the shoulder by a few bending
-            lengths ℓ = √(R t)/(12(1 − ν²))^{1/4}); ``"rim"`` and ``"shoulder"`` are refused:
-            no closed form holds there and demfem has no FEM table for them yet.
+            lengths ℓ = √(R t)/(12(1 − ν²))^{1/4}); ``"rim"`` (the contact centre
+            max(t/2, 1.5 a) from the open end face) or ``"shoulder"`` (max(t/2, 1.5 a) below
+            the body–shoulder junction): the global terms times the FEM factors of
+            :func:`demfem.stress.place_factors.place_factors` (interpolated in log F and μ,
+            clamped at the table's ends: 1–100 N, μ 0–0.2), point contacts ("crossed",
+            "edge") only — a line contact ("parallel", "wall") there is refused.
         cartridge: :class:`demfem.cartridge.Cartridge` (default: the default 3 mL cartridge).
         material: the cartridge's glass, :class:`demfem.materials.Material` (default: the
             cartridge's, the paper's E = 45 GPa, ν = 0.22).
@@ -231,12 +242,13 @@ def contact_stresses(normal_force: Any, tangential_force: Any = 0.0, *,
     t, r_mid, r_out = cart.wall_thickness, cart.body_mid_radius, 0.5 * cart.body_outer_diameter
     nu = mat.nu
     ell = characteristic_length(r_mid, t, nu)
-    if location != "body":
+    if location != "body" and geometry not in PLACE_GEOMETRIES:
         raise InvalidParameterError(
-            f"invalid location = {location!r}: not available — near the open rim and on the "
-            "shoulder no closed form holds and demfem has no FEM table for them yet; only "
-            f"'body' (mid-body, a few bending lengths ell = {ell:.3g} m from the rim and the "
-            "shoulder)")
+            f"invalid location = {location!r} with geometry = {geometry!r}: the rim and "
+            "shoulder factors come from a FEM of a point contact (geometry 'crossed' or "
+            "'edge'); a line contact's ring bending ends at the rim in a way that FEM does "
+            f"not resolve — use location 'body' (mid-body, a few bending lengths "
+            f"ell = {ell:.3g} m from the rim and the shoulder) for line contacts")
     if sliding_direction not in ("major", "minor", "worst"):
         raise InvalidParameterError(f"invalid sliding_direction = {sliding_direction!r}: must "
                                     "be 'major', 'minor' or 'worst'")
@@ -289,7 +301,12 @@ def contact_stresses(normal_force: Any, tangential_force: Any = 0.0, *,
         else:
             r2 = r_out
         A, B = crossed_cylinder_curvatures(r_out, r2, crossing_angle_deg)
-        out = _point(A, B, e_star, direction=sliding_direction, **common)
+        factors = None
+        if location != "body":
+            from demfem.stress.place_factors import place_factors
+
+            factors = place_factors(location, f, mu)
+        out = _point(A, B, e_star, direction=sliding_direction, factors=factors, **common)
     else:
         if edge_radius is not None:
             raise InvalidParameterError(f"invalid edge_radius = {edge_radius!r}: only for "
@@ -325,9 +342,12 @@ def _offset(contact: np.ndarray, bending: np.ndarray) -> np.ndarray:
 
 def _point(A: float, B: float, e_star: float, *, f: np.ndarray, mu: np.ndarray, nu: float,
            t: float, ell: float, m_out: float, m_in: float, mu_cap: float, depth: Any,
-           r_mid: float, free_length: float, direction: str) -> dict[str, np.ndarray]:
+           r_mid: float, free_length: float, direction: str,
+           factors: Optional[dict[str, np.ndarray]] = None) -> dict[str, np.ndarray]:
     """Crossed cylinders: elliptical (or circular) Hertz contact on the cylindrical wall (its
-    field tabulated over c/t, c = √(ab), free over ``free_length``)."""
+    field tabulated over c/t, c = √(ab), free over ``free_length``); ``factors`` (per event,
+    :func:`demfem.stress.place_factors.place_factors`) scale the global terms at the rim or
+    the shoulder."""
     alpha, beta, _ = ellipse_size_factors(A, B)
     a = alpha * np.cbrt(f / e_star)
     if np.any(a >= ell):
@@ -361,11 +381,17 @@ def _point(A: float, B: float, e_star: float, *, f: np.ndarray, mu: np.ndarray, 
                         depth / (a if beta == 1.0 else c), mu)
         contact = contact * g
     bending = _edge_bending(wall, u, radius) * f / t**2
+    ring = np.interp(u, grid, wall["ring_peak"]) * f / t**2
+    area_ring = np.interp(u, grid, wall["ring_area"]) * t * t
+    if factors is not None:
+        inner = inner * factors["inner"]
+        inner_area = inner_area * factors["inner_area"]
+        bending = bending * factors["outer_bending"]
+        ring = ring * factors["ring"]
+        area_ring = area_ring * factors["ring_area"]
     tau = _offset(contact, bending)
     near = contact + bending
     area_near = np.where(near > 0, a * b * ea.interp_mu_tau(table, mu, tau), 0.0)
-    ring = np.interp(u, grid, wall["ring_peak"]) * f / t**2
-    area_ring = np.interp(u, grid, wall["ring_area"]) * t * t
     outer, outer_area = _combine(near, area_near, ring, area_ring, m_out)
     return {"outer_sigma1_max": outer, "inner_sigma1_max": inner,
             "outer_effective_area": outer_area, "inner_effective_area": inner_area,
