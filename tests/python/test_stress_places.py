@@ -135,10 +135,10 @@ def test_place_fem_bad_input():
 @pytest.mark.slow
 def test_place_fem_mid_body_matches_the_quarter_tube_and_the_rim_raises_the_inner_tension():
     """45 N crossed, μ = 0, coarse grading (level 1.25; ≈ 30 s): the half model's mid-body
-    case against the quarter tube's on the same grading (measured: inner −8 %, outer +10 %;
-    the half model's inner peak lags one mesh level behind the quarter's, docs), and the rim
-    case against the body (measured on this grading: inner × 1.75, outer × 1.4; × 1.69 and
-    × 1.61 at the production level 0.64)."""
+    case against the quarter tube's on the same grading (measured: inner −12 %, outer +11 %;
+    the half model's inner peak lags about one mesh level behind the quarter's, docs), and
+    the rim case against the body (measured on this grading: inner × 1.75, outer × 1.48;
+    × 1.69 and × 1.61 at the production level 0.64)."""
     pytest.importorskip("gmsh")
     from demfem.stress import place_fem as pf
     from demfem.stress import resolved_fem as rf
@@ -159,4 +159,4 @@ def test_place_fem_mid_body_matches_the_quarter_tube_and_the_rim_raises_the_inne
     assert body.support["normal_relief_reaction_N"] < 1e-6 * F
     # the open end: the inner tension under the load rises by ≈ 70 %, the outer peak too
     assert ri.sigma1_max / bi.sigma1_max == pytest.approx(1.72, rel=0.12)
-    assert ro.sigma1_max / bo.sigma1_max == pytest.approx(1.5, rel=0.2)
+    assert ro.sigma1_max / bo.sigma1_max == pytest.approx(1.5, rel=0.15)

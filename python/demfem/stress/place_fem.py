@@ -40,8 +40,9 @@ module meshes the cartridge's glass itself and loads it there.
   smoothed along it by :func:`~demfem.stress.fem_recovery.smooth_rim`); on the other surfaces
   (the end face, the shoulder, neck and flange, inside and out) the volume-averaged nodal
   stresses' in-plane part (normals from the mesh's triangles). Per surface (outer: the
-  outer cylinder, the end faces and the outside of shoulder, neck and flange; inner: the
-  inside) the peak σ1, where it is, and the Weibull effective area
+  outer cylinder, the outer half of the flat end faces and the outside of shoulder, neck and
+  flange; inner: the inside and the end faces' inner half — the fire-polished end is a
+  rounding from one surface to the other) the peak σ1, where it is, and the Weibull effective area
   A_eff = ∫ ⟨σ1/σ1,max⟩^m dA over the whole surface (twice the half's), m².
 
 Units: SI (m, N, Pa, m²). gmsh is imported only by :func:`build_place_mesh`.
@@ -143,8 +144,9 @@ class PlaceMesh:
     ``mesh``: the :class:`~demfem.stress.fem_mesh.ResolvedMesh` (nodes in the contact's
     frame: the cartridge's z minus ``z_contact``; ``outer_faces``/``inner_faces`` the outer
     and inner *cylinder* of the body, ``body`` its :class:`TubeSegment`); ``other_outer`` and
-    ``other_inner`` (F, 3): the triangles of the other surfaces outside (the end faces, the
-    outside of shoulder, neck and flange) and inside; ``z_contact`` (m) the contact centre's
+    ``other_inner`` (F, 3): the triangles of the other surfaces outside (the outer half of
+    the flat end faces, the outside of shoulder, neck and flange) and inside (the inner half
+    of the end faces, the inside of shoulder, neck and flange); ``z_contact`` (m) the contact centre's
     height on the cartridge, ``distance`` (m) its distance from the end face (rim), below the
     junction (shoulder) or NaN (body)."""
 
@@ -271,6 +273,16 @@ def build_place_mesh(patch: HertzPatch, place: str, *, cartridge: Any = None,
                 groups["inner"].append(F)
             elif np.all(r <= ri + tol):
                 groups["other_inner"].append(F)
+            elif np.ptp(zz) < tol:
+                # a flat end (the open end face; the flange's top): its inner half goes with
+                # the inner surface, its outer half with the outer (the fire-polished end is
+                # a rounding from one surface to the other)
+                rc = np.hypot(*X[F].mean(1)[:, :2].T)
+                zc_ = float(np.mean(zz))
+                r_in, r_out = c.radii_at(np.array([min(max(zc_, 0.0), c.length)]))
+                inner_half = rc < 0.5 * (float(r_in[0]) + float(r_out[0]))
+                groups["other_inner"].append(F[inner_half])
+                groups["other_outer"].append(F[~inner_half])
             else:
                 groups["other_outer"].append(F)
     finally:
@@ -381,7 +393,7 @@ def _face_name(pm: PlaceMesh, pos: np.ndarray, outer: bool, group: str) -> str:
     side = "outside" if outer else "inside"
     tol = 1e-6 * c.length
     if z < tol:
-        return "open end face"
+        return f"open end face ({side} half)"
     if z <= c.body_length + tol:
         return f"body {side}"
     if z <= c.body_length + c.shoulder_length + tol:
