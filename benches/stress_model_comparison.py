@@ -8,9 +8,13 @@ the same events:
 
 * ``shell``: σ1 = β F/t² (the shell's bending only, the former default);
 * ``contact``: demfem.stress with the measured friction force, cartridges crossed at 90°,
-  the outer surface's characteristic flaw depth (the default of demfem assess);
-* ``contact, no flaw correction``: the same at the surface value;
-* ``contact, parallel``: two cartridges along the body (line contacts).
+  the outer surface's characteristic flaw depth, each event weighted over the places on the
+  cartridge (body, rim, shoulder) by the full-shape table's counts (the default of demfem
+  assess, ``--place mix``);
+* ``contact, body only``: the same with every event at mid-body (``--place body``, the
+  default before the places);
+* ``contact, no flaw correction``: the body-only model at the surface value;
+* ``contact, parallel``: two cartridges along the body (line contacts), body only.
 
     python benches/stress_model_comparison.py [--duration 6] [--out demfem_out/model_cmp]
     python benches/stress_model_comparison.py --folder RUN   # one existing folder's events
@@ -30,11 +34,15 @@ from pathlib import Path
 import numpy as np
 
 VARIANTS = {
-    "shell": dict(model="shell"),
-    "contact": dict(model="contact", pair_geometry="crossed", flaw="characteristic"),
-    "contact, no flaw correction": dict(model="contact", pair_geometry="crossed", flaw=None),
+    "shell": dict(model="shell", place="body"),
+    "contact": dict(model="contact", pair_geometry="crossed", flaw="characteristic",
+                    place="mix"),
+    "contact, body only": dict(model="contact", pair_geometry="crossed",
+                               flaw="characteristic", place="body"),
+    "contact, no flaw correction": dict(model="contact", pair_geometry="crossed", flaw=None,
+                                        place="body"),
     "contact, parallel": dict(model="contact", pair_geometry="parallel",
-                              flaw="characteristic"),
+                              flaw="characteristic", place="body"),
 }
 
 
@@ -42,7 +50,8 @@ def evaluate(out: Path, table, variant: dict) -> dict:
     """The hourly number of one assessment folder's events under one stress model."""
     from demfem.assess.events import EVENT_DTYPE
     from demfem.assess.npz import load_npz
-    from demfem.assess.risk_stage import event_probabilities, passage_risk
+    from demfem.assess.places import event_place_weights
+    from demfem.assess.risk_stage import event_probabilities, hazard_components, passage_risk
     from demfem.risk import INNER_SURFACE, OUTER_SURFACE, SCG_BOROSILICATE
     from demfem.risk.interval import hourly_interval_from_events
     from demfem.stress.stage import characteristic_flaw_depth, collision_stresses
@@ -59,25 +68,34 @@ def evaluate(out: Path, table, variant: dict) -> dict:
                             measured_tangential=ev["peak_tangential_force"],
                             model=variant["model"], cartridge=table.cartridge,
                             pair_geometry=variant.get("pair_geometry", "crossed"),
-                            friction=table.friction, flaw_depth=c)
+                            friction=table.friction, flaw_depth=c,
+                            place_weights=event_place_weights(
+                                ev, [str(x) for x in run.info.get("wall_names", [])],
+                                variant.get("place", "body")))
     p = event_probabilities(st, INNER_SURFACE, OUTER_SURFACE, SCG_BOROSILICATE)
     end = float(run.info["duration"])
     window = (min(2.0, end / 2), end)
     pr = passage_risk(ev, p["p_event"], run.passages(), window)
     inside = (ev["time"] >= window[0]) & (ev["time"] <= window[1])
+    comps = hazard_components(ev[inside], {k: v[inside] for k, v in p.items()},
+                              by_place=False)
     ci = hourly_interval_from_events(ev[inside], p["p_event"][inside], window,
-                                     table.gate_period,
-                                     p_surfaces={"inner": p["p_inner"][inside],
-                                                 "outer": p["p_outer"][inside]})
+                                     table.gate_period, components=comps)
     h_in = float(-np.log1p(-p["p_inner"][inside]).sum())
     h_out = float(-np.log1p(-p["p_outer"][inside]).sum())
     rel = (ci.lower / ci.estimate, ci.upper / ci.estimate) if ci.estimable else (math.nan,) * 2
+    place_share = None
+    if "place_weight" in p:
+        parts = hazard_components(ev[inside], {k: v[inside] for k, v in p.items()})
+        tot = sum(float(v.sum()) for v in parts.values())
+        place_share = {k: float(v.sum()) / tot for k, v in parts.items()} if tot > 0 else None
     return {"broken_per_hour": pr["broken_per_hour"],
             "ci95": [pr["broken_per_hour"] * rel[0], pr["broken_per_hour"] * rel[1]],
             "p_passage": pr["p_passage"], "discharge_per_hour": pr["discharge_per_hour"],
             "outer_share": h_out / (h_in + h_out) if h_in + h_out > 0 else math.nan,
             "max_sigma_outer_MPa": float(st["sigma_outer_Pa"][inside].max() / 1e6),
-            "max_sigma_inner_MPa": float(st["sigma_inner_Pa"][inside].max() / 1e6)}
+            "max_sigma_inner_MPa": float(st["sigma_inner_Pa"][inside].max() / 1e6),
+            "place_surface_share": place_share}
 
 
 def main() -> None:
@@ -108,6 +126,9 @@ def main() -> None:
                   f"{r['ci95'][1]:.3g}]  outer share {r['outer_share']:.4f}  max sigma1 "
                   f"outer {r['max_sigma_outer_MPa']:.3g} MPa, inner "
                   f"{r['max_sigma_inner_MPa']:.3g} MPa")
+            if r["place_surface_share"]:
+                print("    by place and surface: " + ", ".join(
+                    f"{k} {100 * v:.3g} %" for k, v in r["place_surface_share"].items()))
         return
     rows = {}
     for v in (float(x) for x in args.speeds.split(",")):

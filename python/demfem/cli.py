@@ -284,8 +284,8 @@ def _cmd_assess(args: argparse.Namespace) -> int:
                                         "characteristic, none or a depth in m") from None
     settings = dict(duration=args.duration, quick=args.quick, full=args.full,
                     throughput=args.throughput, stress_model=model, refeed=not args.no_refeed,
-                    csv=args.csv, pair_geometry=args.pair_geometry, flaw_depth=flaw,
-                    strength=args.strength)
+                    csv=args.csv, pair_geometry=args.pair_geometry, place=args.place,
+                    flaw_depth=flaw, strength=args.strength)
     if args.replicas is not None or args.precision is not None:
         from demfem.assess.replicas import assess_replicas
 
@@ -482,6 +482,10 @@ def build_parser() -> argparse.ArgumentParser:
     a.add_argument("--pair-geometry", default="crossed", choices=("crossed", "parallel"),
                    help="how two cartridges touch: crossed at 90 degrees (default, a point "
                         "contact) or parallel along the body (a line contact)")
+    a.add_argument("--place", default="mix", choices=("mix", "body", "rim", "shoulder"),
+                   help="where on the cartridge the events land: mix (default: weighted over "
+                        "body, rim and shoulder by the full-shape table's counts, "
+                        "docs/cartridge-places.md) or every event at one place")
     a.add_argument("--flaw-depth", default="characteristic", metavar="characteristic|none|M",
                    help="depth of the outer surface's flaws at which the contact tension is "
                         "felt: characteristic (default: the flaw that fails at sigma_0), none "

@@ -66,7 +66,7 @@ EVENT_DTYPE = np.dtype([
 ])
 
 
-def _centres_at(run, t: np.ndarray, idx: np.ndarray) -> np.ndarray:
+def centres_at(run, t: np.ndarray, idx: np.ndarray) -> np.ndarray:
     """Centres (n, 3) of spheres ``idx`` at times ``t`` (s), interpolated between samples."""
     times = np.asarray(run.times, float)
     k = np.clip(np.searchsorted(times, t, side="right") - 1, 0, len(times) - 1)
@@ -110,8 +110,8 @@ def impact_events(run, min_speed: float = DEFAULT_MIN_SPEED,
     ev["peak_force"] = ev["duration"] = ev["impulse"] = ev["peak_tangential_force"] = np.nan
     if len(sel):
         t = np.asarray(sel["time"], float)
-        ci = _centres_at(run, t, np.asarray(sel["i"]))
-        cj = _centres_at(run, t, np.asarray(sel["j"]))
+        ci = centres_at(run, t, np.asarray(sel["i"]))
+        cj = centres_at(run, t, np.asarray(sel["j"]))
         d = cj - ci
         norm = np.linalg.norm(d, axis=1)
         unit = np.where(norm[:, None] > 0, d / np.where(norm > 0, norm, 1.0)[:, None], 0.0)

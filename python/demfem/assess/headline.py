@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-__all__ = ["headline", "plain_reading", "fmt"]
+__all__ = ["headline", "plain_reading", "fmt", "place_line"]
 
 
 def fmt(x: Any, digits: int = 3) -> str:
@@ -62,3 +62,15 @@ def headline(summary: dict[str, Any]) -> str:
     return (f"Expected broken cartridges per hour: {fmt(value)}{interval} {at}: "
             f"{plain_reading(value)}. Probability that one cartridge breaks on its passage: "
             f"{fmt(s['p_passage'])}.")
+
+
+def place_line(summary: dict[str, Any]) -> str:
+    """Where on the cartridge the hazard comes from, one line from ``risk.json``'s summary
+    (``place_share``): "rim 71 %, body 20 %, shoulder 9 %", largest first; empty without
+    places."""
+    shares = summary.get("place_share")
+    if not shares:
+        return ""
+    parts = [f"{name} {fmt(100 * v, 3)} %" for name, v in
+             sorted(shares.items(), key=lambda kv: -kv[1])]
+    return "Where on the cartridge the hazard comes from: " + ", ".join(parts) + "."

@@ -66,6 +66,8 @@ class JobContext:
         surfaces: ``inner`` and ``outer`` surface strengths (:class:`demfem.risk`
             surfaces), their ``source`` in words and the ``measured`` ones.
         flaw_depth: depth of the outer surface's flaws, m; None: the surface value.
+        place: where on the cartridge the events land (:data:`demfem.assess.places.
+            PLACE_MODES`: ``"mix"``, the full-shape table's weights, or one place).
         csv: also write the tables as CSV.
         threads: DEM threads.
         checkpoint_every: wall time between DEM checkpoints, s.
@@ -102,6 +104,7 @@ class JobContext:
     seed: Optional[int]
     produced: dict[str, Any] = field(default_factory=dict)
     digests: dict[str, Any] = field(default_factory=dict)
+    place: str = "mix"
 
     def window(self) -> tuple[float, float]:
         """The statistics window (start, end), s, once the DEM stage has run: every whole

@@ -84,15 +84,20 @@ def _model_words(model: Any, pair_geometry: str) -> str:
 
 def _calibration_stresses(forces: np.ndarray, table, e_stress: float, model: Any,
                           pair_geometry: str, surfaces: dict[str, Any],
-                          flaw_depth: Optional[float] = None) -> dict[str, Any]:
+                          flaw_depth: Optional[float] = None,
+                          place: str = "body") -> dict[str, Any]:
     """σ1 outside and inside of two cartridges at the calibration's ``forces`` (N), without
-    friction and sliding at the table's μ (Pa), at Young's modulus ``e_stress`` (Pa)."""
+    friction and sliding at the table's μ (Pa), at Young's modulus ``e_stress`` (Pa), at the
+    worst place a contact between cartridges may land on (``place``,
+    :mod:`demfem.assess.places`)."""
+    from demfem.assess.places import pair_place_weights
     from demfem.stress.stage import collision_stresses
 
     f = np.asarray(forces, float)
     kw = dict(model=model, cartridge=table.cartridge, pair_geometry=pair_geometry,
               friction=table.friction, weibull_modulus_inner=surfaces["inner"].weibull_modulus,
-              weibull_modulus_outer=surfaces["outer"].weibull_modulus, flaw_depth=flaw_depth)
+              weibull_modulus_outer=surfaces["outer"].weibull_modulus, flaw_depth=flaw_depth,
+              place_weights=pair_place_weights(f.size, place).reshape(f.shape + (-1,)))
     speeds = np.full(f.shape, 0.0)
     code = np.zeros(f.shape, np.int64)
     still = collision_stresses(speeds, code, e_stress, table.poisson_ratio, measured_force=f,
@@ -122,7 +127,8 @@ def _stress_curves(ctx: JobContext, stress: dict[str, np.ndarray]) -> dict[str, 
     f = np.geomspace(max(1e-3, 1e-3 * top), max(top, 1e-2), 40)
     return {"force_N": f, "friction": ctx.table.friction,
             **_calibration_stresses(f, ctx.table, ctx.stress_young_modulus, ctx.model,
-                                    ctx.pair_geometry, ctx.surfaces, ctx.flaw_depth)}
+                                    ctx.pair_geometry, ctx.surfaces, ctx.flaw_depth,
+                                    ctx.place)}
 
 
 def _hazard_of_force(ctx: JobContext, events: np.ndarray, stress: dict[str, np.ndarray],
@@ -132,6 +138,7 @@ def _hazard_of_force(ctx: JobContext, events: np.ndarray, stress: dict[str, np.n
     the window's hard impacts' median friction ratio Q/F and the calibrated law's duration at
     F, for the tail model; and the force cap, the law's force of a 1 m/s impact (N)."""
     from demfem.assess.impact import ImpactLaw, cartridge_body
+    from demfem.assess.places import pair_place_weights
     from demfem.assess.risk_stage import event_probabilities
     from demfem.stress.stage import collision_stresses
 
@@ -160,7 +167,8 @@ def _hazard_of_force(ctx: JobContext, events: np.ndarray, stress: dict[str, np.n
                                 friction=table.friction,
                                 weibull_modulus_inner=surfaces["inner"].weibull_modulus,
                                 weibull_modulus_outer=surfaces["outer"].weibull_modulus,
-                                flaw_depth=ctx.flaw_depth)
+                                flaw_depth=ctx.flaw_depth,
+                                place_weights=pair_place_weights(f.size, ctx.place))
         p = event_probabilities(st, surfaces["inner"], surfaces["outer"], ctx.slow_crack_growth)
         return 2.0 * -np.log1p(-p["p_event"])
 
@@ -195,7 +203,7 @@ class CalibrationStage(Stage):
                "stress_model": ctx.settings["stress_model"], "pair_geometry": ctx.pair_geometry}
         cal.update(_calibration_stresses(law.force(np.array(speeds)), table, e_stress,
                                          ctx.model, ctx.pair_geometry, ctx.surfaces,
-                                         ctx.flaw_depth))
+                                         ctx.flaw_depth, ctx.place))
         path = ctx.out / "calibration.json"
         write_json_atomic(path, cal)
         return StageOutput([path])
@@ -352,10 +360,12 @@ class StressStage(Stage):
                f"are at {e_stress:.3g} Pa)" if summary.get("measured") else "")))
 
     def run(self, ctx: JobContext) -> StageOutput:
+        from demfem.assess.places import event_place_weights
         from demfem.stress.stage import collision_stresses
 
         events, surfaces = ctx.produced["events"][0], ctx.surfaces
         use_measured = self._measured(ctx)
+        wall_names = [str(x) for x in ctx.produced["dem"].info.get("wall_names", [])]
         stress = collision_stresses(
             events["normal_speed"], events["partner"], ctx.stress_young_modulus,
             ctx.table.poisson_ratio,
@@ -367,7 +377,8 @@ class StressStage(Stage):
             friction=ctx.table.friction,
             weibull_modulus_inner=surfaces["inner"].weibull_modulus,
             weibull_modulus_outer=surfaces["outer"].weibull_modulus,
-            flaw_depth=ctx.flaw_depth)
+            flaw_depth=ctx.flaw_depth,
+            place_weights=event_place_weights(events, wall_names, ctx.place))
         path = ctx.out / "stress.npz"
         save_npz(path, **stress)
         return StageOutput([path])
@@ -401,7 +412,7 @@ class RiskStage(Stage):
 
     name = "risk"
     files = ("risk.json", "events.parquet", "passages.parquet", "events.csv", "passages.csv",
-             "events.vtp", "cartridges.vtp", "risk_arrays.npz")
+             "events.vtp", "cartridges.vtp", "cartridge_places.vtp", "risk_arrays.npz")
 
     def title(self, ctx: JobContext) -> str:
         return "Weibull probabilities per event, cartridge and hour"
@@ -423,10 +434,12 @@ class RiskStage(Stage):
         return json.loads((ctx.out / "risk.json").read_text(encoding="utf-8"))
 
     def show(self, ctx: JobContext) -> None:
-        from demfem.assess.headline import headline
+        from demfem.assess.headline import headline, place_line
 
         risk = ctx.produced[self.name]
         ctx.log("  " + headline(risk["summary"]))
+        if place_line(risk["summary"]):
+            ctx.log("  " + place_line(risk["summary"]))
         check = risk.get("period_check") or {}
         if check.get("dominated"):
             ctx.log("  Warning: " + check["text"])
@@ -472,7 +485,8 @@ class ReportStage(Stage):
     def show(self, ctx: JobContext) -> None:
         ctx.log(f"  written to {ctx.out}: report.html, risk.json, events.parquet, "
                 "passages.parquet" + (" (and .csv)" if ctx.csv else "") + ", "
-                "events.vtp, cartridges.vtp (ParaView), " + ", ".join(FIGURES))
+                "events.vtp, cartridges.vtp, cartridge_places.vtp (ParaView), "
+                + ", ".join(FIGURES))
 
     def answer(self, ctx: JobContext) -> dict[str, Any]:
         return ctx.produced["risk"]

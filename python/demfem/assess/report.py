@@ -51,7 +51,7 @@ def render_report(risk: dict[str, Any], figures: dict[str, bytes],
              "&rarr; stress model &rarr; Weibull risk. SI units throughout.</p>"]
     for w in risk["warnings"]:
         parts.append(f"<p class='warn'>{html.escape(w)}</p>")
-    from demfem.assess.headline import fmt, headline
+    from demfem.assess.headline import fmt, headline, place_line
 
     parts.append(f"<p class='headline'><b>{html.escape(headline(s))}</b></p>")
     strength = risk.get("strength", {})
@@ -79,6 +79,7 @@ def render_report(risk: dict[str, Any], figures: dict[str, bytes],
                      fmt(s["broken_per_hour_at_throughput"])))
     rows += [
         ("share of the hazard from the inner surface", fmt(s["inner_share"])),
+        *((("by place on the cartridge", place_line(s)),) if place_line(s) else ()),
         ("impacts on walls and gate in the window", fmt(s["n_wall_events_window"])),
         ("share of the hazard from wall and gate impacts", fmt(s["wall_share"])),
         *((f"share of the hazard from the {name.replace('_', ' ')}", fmt(v))
@@ -90,12 +91,19 @@ def render_report(risk: dict[str, Any], figures: dict[str, bytes],
     parts.append(_table(rows, cls="summary"))
     splits = (risk.get("interval") or {}).get("splits") or {}
     if splits:
-        names = {"component": "by surface and mechanism", "with": "by place on the table"}
+        names = {"component": "by surface and mechanism", "with": "by place on the table",
+                 "place": "by place on the cartridge",
+                 "place_surface": "by place on the cartridge and surface"}
         what = {"outer": "outer surface: contact tension (with bending)",
-                "inner": "inner surface: bending tension"}
+                "inner": "inner surface: bending tension",
+                "rim": "rim (the open end: the paper's fire-polish area)",
+                "body": "body", "shoulder": "shoulder (the body-shoulder junction)"}
+        for place in ("rim", "body", "shoulder"):
+            for surf in ("outer", "inner"):
+                what[f"{place} {surf}"] = f"{place}, {surf} surface"
         parts.append("<h3>Where the hazard comes from, with 95 % intervals</h3><p>Shares of "
                      "the hourly number from the same gate periods as its interval.</p>")
-        for group in ("component", "with"):
+        for group in ("place", "place_surface", "component", "with"):
             rows_s = []
             for label, d in sorted((splits.get(group) or {}).items(),
                                    key=lambda kv: -(kv[1].get("share") or 0)):
@@ -114,12 +122,14 @@ def render_report(risk: dict[str, Any], figures: dict[str, bytes],
                  "at least the force of an impact at that speed.</p>"
                  "<table><tr><th>event</th><th>cartridge – partner</th><th>kind</th>"
                  "<th>time, s</th><th>x, y, m</th><th>v_n, m/s</th><th>F, N</th>"
+                 "<th>worst place</th>"
                  "<th>σ1 inner, MPa</th><th>σ1 outer, MPa</th><th>P_k</th></tr>")
     for r in risk["worst_events"]:
         parts.append(f"<tr><td>{r['event']}</td><td>{r['i']} – {html.escape(r['with'])}</td>"
                      f"<td>{html.escape(r.get('kind', 'impact'))}</td>"
                      f"<td>{r['time_s']:.4g}</td><td>{r['x_m']:.3f}, {r['y_m']:.3f}</td>"
                      f"<td>{r['normal_speed_m_per_s']:.3g}</td><td>{r['force_N']:.3g}</td>"
+                     f"<td>{html.escape(r.get('place', 'body'))}</td>"
                      f"<td>{r['sigma_inner_Pa'] / 1e6:.3g}</td>"
                      f"<td>{r['sigma_outer_Pa'] / 1e6:.3g}</td><td>{r['p_event']:.3g}</td></tr>")
     parts.append("</table>")
@@ -161,6 +171,7 @@ def render_report(risk: dict[str, Any], figures: dict[str, bytes],
                  "collisions, the settings), events.parquet (one row per event) and "
                  "passages.parquet (one row per passage of a cartridge over the table), each "
                  "column named with its SI unit (demfem.assess.load_assessment reads them into "
-                 "pandas; --csv writes them as CSV too), events.vtp and cartridges.vtp "
-                 "(ParaView), stages.json (stage record), the figures as PNG.</p></body></html>")
+                 "pandas; --csv writes them as CSV too), events.vtp, cartridges.vtp and "
+                 "cartridge_places.vtp (the events at their places on one cartridge; "
+                 "ParaView), stages.json (stage record), the figures as PNG.</p></body></html>")
     return "\n".join(parts)

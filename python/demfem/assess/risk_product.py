@@ -7,13 +7,15 @@ probabilities are in ``events.parquet`` only."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from pathlib import Path
 from typing import Any, Optional
 
 import numpy as np
 
-from demfem.assess.risk_stage import (event_hazard, event_probabilities, partner_name,
-                                      passage_risk, risk_map, steady_state, worst_events)
+from demfem.assess.risk_stage import (event_hazard, event_probabilities, hazard_components,
+                                      partner_name, passage_risk, risk_map, steady_state,
+                                      worst_events)
 
 __all__ = ["risk_document", "VTK_EVENTS"]
 
@@ -61,6 +63,73 @@ def _write_vtk(out: Path, run, events: np.ndarray, p: dict[str, np.ndarray],
     return files
 
 
+def _write_places_vtk(out: Path, run, cartridge: Any, events: np.ndarray,
+                      p: dict[str, np.ndarray], stress: dict[str, np.ndarray],
+                      inside: np.ndarray) -> Path:
+    """``cartridge_places.vtp``: the events of ``events.vtp`` at their places on one
+    reference cartridge (its frame: z up its axis from the open end, m): a point on the
+    outer surface per event and place it may land on (rim t/2 above the end, mid-body, or
+    t/2 below the shoulder), at the azimuth of the contact point seen from the cartridge's
+    centre on the table; with that place's term of P_k (``p_event_place``), the place
+    (0 body, 1 rim, 2 shoulder), its weight, the event and its force (N)."""
+    from demfem.assess.events import centres_at
+    from demfem.io.vtk import write_vtp
+
+    c = cartridge
+    idx = np.flatnonzero(inside)
+    idx = idx[np.argsort(-p["p_event"][idx], kind="stable")][:VTK_EVENTS]
+    t, r = c.wall_thickness, 0.5 * c.body_outer_diameter
+    heights = np.array([0.5 * c.body_length, 0.5 * t, c.body_length - 0.5 * t])
+    centre = centres_at(run, events["time"][idx], np.asarray(events["i"][idx], np.int64))
+    theta = np.arctan2(events["y"][idx] - centre[:, 1], events["x"][idx] - centre[:, 0])
+    w = np.asarray(p["place_weight"], float)[idx]
+    ev, pl = np.nonzero(w > 0)
+    pts = np.column_stack([r * np.cos(theta[ev]), r * np.sin(theta[ev]), heights[pl]])
+    ok = np.all(np.isfinite(pts), axis=1)
+    ev, pl, pts = ev[ok], pl[ok], pts[ok]
+    k = idx[ev]
+    return write_vtp(out / "cartridge_places.vtp", pts, {
+        "p_event_place": np.asarray(p["p_event_by_place"], float)[k, pl],
+        "place": pl.astype(np.int64), "weight": w[ev, pl], "event": k.astype(np.int64),
+        "force_N": stress["force_N"][k],
+        "sigma_outer_Pa": np.asarray(stress["sigma_outer_Pa_by_place"], float)[k, pl],
+        "sigma_inner_Pa": np.asarray(stress["sigma_inner_Pa_by_place"], float)[k, pl]})
+
+
+def _place_summary(events: np.ndarray, p: dict[str, np.ndarray],
+                   inside: np.ndarray) -> dict[str, Any]:
+    """Shares of the window's hazard by place on the cartridge (``place_share``) and by
+    place and surface (``place_surface_share``), when the events have places."""
+    if "place_weight" not in p:
+        return {}
+    parts = hazard_components(events, p)
+    tot = sum(float(v[inside].sum()) for v in parts.values())
+    if tot <= 0:
+        return {"place_share": None, "place_surface_share": None}
+    both = {k: float(v[inside].sum()) / tot for k, v in parts.items()}
+    places: dict[str, float] = {}
+    for k, v in both.items():
+        places[k.split()[0]] = places.get(k.split()[0], 0.0) + v
+    return {"place_share": places, "place_surface_share": both}
+
+
+def _place_columns(stress: dict[str, np.ndarray], p: dict[str, np.ndarray]
+                   ) -> dict[str, np.ndarray]:
+    """``events.parquet``'s place columns: the worst place the event may land on (whose σ1
+    the stress columns hold) and each place's term w_p P_k,p of ``p_event``."""
+    from demfem.stress.model import LOCATIONS
+
+    if "place_weight" not in p:
+        return {}
+    cols: dict[str, np.ndarray] = {
+        "place": np.asarray(LOCATIONS, dtype="U8")[np.asarray(stress["place_index"],
+                                                               np.int64)]}
+    for j, name in enumerate(LOCATIONS):
+        cols[f"weight_{name}"] = np.asarray(p["place_weight"], float)[:, j]
+        cols[f"p_event_{name}"] = np.asarray(p["p_event_by_place"], float)[:, j]
+    return cols
+
+
 def _stress_basis(model: Any, settings: dict[str, Any]) -> str:
     """What the stresses rest on, in words."""
     from demfem.stress.stress_model import StressModel
@@ -73,17 +142,42 @@ def _stress_basis(model: Any, settings: dict[str, Any]) -> str:
                 f"{m.area_factor_outer:.4g} (outer) times the Hertz patch pi a^2. Source: "
                 f"{m.source}. It leaves out the contact stress on the outer surface.")
     pair = settings.get("pair_geometry", "crossed")
+    depth = settings.get("flaw_depth_m")
+    place = settings.get("place", "body")
     return ("Stress model (demfem.stress, docs/stress.md): on the outer surface the contact "
             "field with the measured friction force (Hertz; Hamilton 1983: the trailing-edge "
-            "tension p0 [(1 - 2 nu)/3 + (4 + nu) pi mu/8]) on top of the shell's bending, on "
-            "the inner surface the bending tension under the load (Reissner's shallow shell, "
-            "the ring under a line load); Weibull effective areas of both fields. The DEM's "
-            "spheres carry no axis, so the geometry is assumed: two cartridges "
+            "tension p0 [(1 - 2 nu)/3 + (4 + nu) pi mu/8]) on top of the wall's bending, on "
+            "the inner surface the bending tension under the load (the body as a cylindrical "
+            "shell: Bijlaard's double series in Sanders-Koiter theory with the wall's "
+            "thick-plate correction; the ring under a line load); Weibull effective areas of "
+            "both fields. The DEM's spheres carry no axis, so the geometry is assumed: two "
+            "cartridges "
             + ("crossed at 90 degrees (a point contact: the severe case)" if pair == "crossed"
                else "side by side along the body (a line contact)")
-            + ", walls and gate along the body (a line contact); mid-body, away from the rim "
-            "and the shoulder. No flaw-depth correction (conservative where the contact field "
-            "is shallower than the flaws).")
+            + ", walls and gate along the body (a line contact). "
+            + (f"The contact-edge tension is taken as a flaw {depth:.3g} m deep feels it (the "
+               "flaw that fails at the outer surface's characteristic strength unless given; "
+               "docs/stress.md)." if depth else
+               "No flaw-depth correction: the surface value of the contact-edge tension "
+               "(conservative where the contact field is shallower than the flaws).")
+            + " " + _place_basis(place))
+
+
+def _place_basis(place: str) -> str:
+    """Where on the cartridge the events are taken to land, in words."""
+    from demfem.assess.places import PLACE_WEIGHTS
+
+    if place != "mix":
+        return (f"Place on the cartridge: every event at the {place} "
+                + ("(mid-body, away from the rim and the shoulder)." if place == "body" else
+                   "(the stress model's FEM factors for that place, docs/stress.md)."))
+    w = PLACE_WEIGHTS["weights"]["cartridge"]
+    return ("Place on the cartridge: the spheres carry no height, so each event's place is "
+            "weighted by the full-shape table's counts for its partner (docs/cartridge-"
+            f"places.md): between cartridges body {w[0]:.0%}, rim {w[1]:.0%}, shoulder "
+            f"{w[2]:.0%}; P_k is the expectation over the places, and the hazard splits by "
+            "place exactly. The place is not conditioned on the force (the full-shape table "
+            "recorded it per partner only).")
 
 
 def _basis(model, scg, ev_summary: dict[str, Any], e_stress: float, table,
@@ -156,10 +250,22 @@ def _interval(events: np.ndarray, p: dict[str, np.ndarray], inside: np.ndarray,
     from demfem.risk.interval import hourly_interval_from_events
 
     block = float(period) if period else 1.0
-    ci = hourly_interval_from_events(events[inside], p["p_event"][inside], window, block,
-                                     wall_names=wall_names,
-                                     p_surfaces={"inner": p["p_inner"][inside],
-                                                 "outer": p["p_outer"][inside]})
+    ev = events[inside]
+    comps = hazard_components(ev, {k: v[inside] for k, v in p.items()}, by_place=False)
+    ci = hourly_interval_from_events(ev, p["p_event"][inside], window, block,
+                                     wall_names=wall_names, components=comps)
+    if "place_weight" in p:
+        parts = hazard_components(ev, {k: v[inside] for k, v in p.items()})
+        places = {pl: parts[f"{pl} outer"] + parts[f"{pl} inner"]
+                  for pl in {k.split()[0]: None for k in parts}}
+        by_place = hourly_interval_from_events(ev, p["p_event"][inside], window, block,
+                                               wall_names=wall_names, components=places)
+        by_both = hourly_interval_from_events(ev, p["p_event"][inside], window, block,
+                                              wall_names=wall_names, components=parts)
+        splits = dict(ci.splits)
+        splits["place"] = by_place.splits.get("component", {})
+        splits["place_surface"] = by_both.splits.get("component", {})
+        ci = replace(ci, splits=splits)
 
     def carried(value: float) -> Optional[list[float]]:
         if not (ci.estimable and ci.estimate > 0 and math.isfinite(value)):
@@ -336,6 +442,7 @@ def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[st
             float(table.young_modulus), e_stress, rel_tol=1e-12),
         "max_sigma_inner_Pa": mx(stress["sigma_inner_Pa"][inside]),
         "max_sigma_outer_Pa": mx(stress["sigma_outer_Pa"][inside]),
+        **_place_summary(events, p, inside),
     }
     warnings = []
     if table.young_modulus < PAPER_GLASS.E:
@@ -390,12 +497,14 @@ def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[st
              "sigma_outer_Pa": stress["sigma_outer_Pa"],
              "area_inner_m2": stress["area_inner_m2"], "area_outer_m2": stress["area_outer_m2"],
              "p_inner": p["p_inner"], "p_outer": p["p_outer"], "p_event": p["p_event"],
-             "in_window": inside}
+             "in_window": inside, **_place_columns(stress, p)}
     files += write_table(out / "events.parquet", events_columns(events, extra, wall_names),
                          csv)
     files += write_table(out / "passages.parquet", passages_columns(passages, run.tags, pr),
                          csv)
     files += _write_vtk(out, run, events, p, stress, passages, pr, inside)
+    if "place_weight" in p:
+        files.append(_write_places_vtk(out, run, table.cartridge, events, p, stress, inside))
     files.append(save_npz(out / "risk_arrays.npz", p_window=pr["p_window"],
                           **{f"map_{k}": v for k, v in rmap.items()}))
     return files

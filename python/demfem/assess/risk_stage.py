@@ -39,7 +39,7 @@ from demfem.risk import (INNER_SURFACE, OUTER_SURFACE, SCG_BOROSILICATE, SlowCra
                          SurfaceStrength)
 from demfem.risk.fatigue import half_sine_sn_factor
 
-__all__ = ["event_probabilities", "surface_probability",
+__all__ = ["event_probabilities", "surface_probability", "hazard_components",
            "equivalent_stress", "passage_risk", "event_hazard", "steady_state",
            "worst_events", "partner_name", "risk_map"]
 
@@ -82,15 +82,65 @@ def event_probabilities(stress: dict[str, np.ndarray], inner: SurfaceStrength = 
                         scg: Optional[SlowCrackGrowth] = SCG_BOROSILICATE) -> dict[str, np.ndarray]:
     """``p_inner``, ``p_outer``, ``p_event`` and the stresses used (``sigma_eq_inner_Pa``,
     ``sigma_eq_outer_Pa``) of each event from the stress stage's arrays ``sigma_inner_Pa``,
-    ``sigma_outer_Pa``, ``area_inner_m2``, ``area_outer_m2``, ``duration_s``."""
+    ``sigma_outer_Pa``, ``area_inner_m2``, ``area_outer_m2``, ``duration_s``.
+
+    With places (the stress stage's ``place_weight`` and ``*_by_place`` arrays,
+    :mod:`demfem.assess.places`): the expectation over the event's place,
+    P_k = Σ_p w_p P_k,p, and the same for each surface; ``p_event_by_place``,
+    ``p_inner_by_place``, ``p_outer_by_place`` (n, 3) hold the terms w_p P_k,p, whose rows
+    sum to ``p_event``, ``p_inner``, ``p_outer``. The equivalent stresses are those of the
+    worst place (the one-value stress fields)."""
     tau = stress["duration_s"]
     s_in = equivalent_stress(stress["sigma_inner_Pa"], tau, scg)
     s_out = equivalent_stress(stress["sigma_outer_Pa"], tau, scg)
-    p_in = surface_probability(inner, s_in, stress["area_inner_m2"])
-    p_out = surface_probability(outer, s_out, stress["area_outer_m2"])
-    p = -np.expm1(np.log1p(-p_in) + np.log1p(-p_out))
-    return {"p_inner": p_in, "p_outer": p_out, "p_event": p,
+    if "place_weight" not in stress:
+        p_in = surface_probability(inner, s_in, stress["area_inner_m2"])
+        p_out = surface_probability(outer, s_out, stress["area_outer_m2"])
+        p = -np.expm1(np.log1p(-p_in) + np.log1p(-p_out))
+        return {"p_inner": p_in, "p_outer": p_out, "p_event": p,
+                "sigma_eq_inner_Pa": s_in, "sigma_eq_outer_Pa": s_out}
+    w = np.asarray(stress["place_weight"], float)
+    tau2 = np.asarray(tau, float)[:, None]
+    pi = surface_probability(inner, equivalent_stress(stress["sigma_inner_Pa_by_place"], tau2,
+                                                      scg), stress["area_inner_m2_by_place"])
+    po = surface_probability(outer, equivalent_stress(stress["sigma_outer_Pa_by_place"], tau2,
+                                                      scg), stress["area_outer_m2_by_place"])
+    pe = -np.expm1(np.log1p(-pi) + np.log1p(-po))
+    by = {"p_inner_by_place": w * pi, "p_outer_by_place": w * po, "p_event_by_place": w * pe}
+    return {"p_inner": by["p_inner_by_place"].sum(axis=1),
+            "p_outer": by["p_outer_by_place"].sum(axis=1),
+            "p_event": by["p_event_by_place"].sum(axis=1), **by,
+            "p_inner_at_place": pi, "p_outer_at_place": po, "place_weight": w,
             "sigma_eq_inner_Pa": s_in, "sigma_eq_outer_Pa": s_out}
+
+
+def hazard_components(events: np.ndarray, p: dict[str, np.ndarray],
+                      by_place: bool = True) -> dict[str, np.ndarray]:
+    """The hazard each event puts on the cartridges (:func:`event_hazard`) split into parts
+    that add up to it exactly: by surface (``outer``, ``inner``), and with places (and
+    ``by_place``) by place and surface (``"rim outer"``, ``"body inner"``, …; the place's
+    weight times its hazard −ln(1 − P_k,p,s), in proportion). ``by_place=False`` with places
+    gives the two surfaces summed over the places."""
+    from demfem.stress.model import LOCATIONS
+
+    loads = np.where(events["j"] >= 0, 2.0, 1.0)
+    h = -np.log1p(-np.asarray(p["p_event"], float)) * loads
+    if "p_inner_at_place" not in p:
+        hi = -np.log1p(-np.asarray(p["p_inner"], float))
+        ho = -np.log1p(-np.asarray(p["p_outer"], float))
+        tot = hi + ho
+        safe = np.where(tot > 0, tot, 1.0)
+        return {"outer": np.where(tot > 0, h * ho / safe, 0.0),
+                "inner": np.where(tot > 0, h * hi / safe, 0.0)}
+    w = np.asarray(p["place_weight"], float)
+    parts = {"outer": w * -np.log1p(-np.asarray(p["p_outer_at_place"], float)),
+             "inner": w * -np.log1p(-np.asarray(p["p_inner_at_place"], float))}
+    tot = parts["outer"].sum(axis=1) + parts["inner"].sum(axis=1)
+    scale = np.where(tot > 0, h / np.where(tot > 0, tot, 1.0), 0.0)
+    if not by_place:
+        return {s: parts[s].sum(axis=1) * scale for s in ("outer", "inner")}
+    return {f"{place} {s}": parts[s][:, j] * scale
+            for j, place in enumerate(LOCATIONS) for s in ("outer", "inner")}
 
 
 def passage_risk(events: np.ndarray, p_event: np.ndarray, table: np.ndarray,
@@ -232,8 +282,11 @@ def worst_events(events: np.ndarray, p: dict[str, np.ndarray], stress: dict[str,
                  window: tuple[float, float], count: int = 10,
                  wall_names: Sequence[str] = ()) -> list[dict[str, Any]]:
     """The ``count`` events of the window with the largest P_k, as rows (SI units in keys);
-    ``with`` names the partner: ``cartridge j`` or the wall (``wall_names`` by index)."""
+    ``with`` names the partner: ``cartridge j`` or the wall (``wall_names`` by index);
+    ``place`` the worst place on the cartridge the event may land on (whose σ1 the row
+    gives; ``body`` without places)."""
     from demfem.assess.impact import PARTNERS
+    from demfem.stress.model import LOCATIONS
 
     inside = np.flatnonzero((events["time"] >= window[0]) & (events["time"] <= window[1]))
     order = inside[np.argsort(-p["p_event"][inside], kind="stable")][:count]
@@ -248,6 +301,8 @@ def worst_events(events: np.ndarray, p: dict[str, np.ndarray], stress: dict[str,
                      "kind": "pressed by the queue" if bool(e["pressed"]) else "impact",
                      "tangential_force_N": float(e["peak_tangential_force"]),
                      "force_N": float(stress["force_N"][k]),
+                     "place": (LOCATIONS[int(stress["place_index"][k])]
+                               if "place_index" in stress else "body"),
                      "sigma_inner_Pa": float(stress["sigma_inner_Pa"][k]),
                      "sigma_outer_Pa": float(stress["sigma_outer_Pa"][k]),
                      "p_inner": float(p["p_inner"][k]), "p_outer": float(p["p_outer"][k]),

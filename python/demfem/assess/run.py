@@ -86,7 +86,7 @@ def steady_rule(table, full: bool = False, min_speed: float = DEFAULT_MIN_SPEED)
 OUTPUT_FILES = ("calibration.json", "table_run.npz", "table_run_full.npz", "events.npz",
                 "stress.npz", "risk.json",
                 "events.parquet", "passages.parquet", "events.csv", "passages.csv",
-                "events.vtp", "cartridges.vtp",
+                "events.vtp", "cartridges.vtp", "cartridge_places.vtp",
                 "risk_arrays.npz", "report.html")
 
 
@@ -96,6 +96,7 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
            sample_interval: Optional[float] = None, min_speed: float = DEFAULT_MIN_SPEED,
            discard_before: Optional[float] = None,
            stress_model: Optional[str | StressModel] = None, pair_geometry: str = "crossed",
+           place: str = "mix",
            flaw_depth: Optional[float | str] = "characteristic",
            stress_young_modulus: Optional[float] = None, slow_crack_growth: bool = True,
            threads: int = 1, checkpoint_every: float = 15.0,
@@ -127,6 +128,10 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
         pair_geometry: the contact of two cartridges, ``"crossed"`` (default: axes at 90°, a
             point contact) or ``"parallel"`` (upright, along the body: a line contact)
             (:data:`demfem.stress.stage.PAIR_GEOMETRIES`); walls: along the body.
+        place: where on the cartridge the events land (:mod:`demfem.assess.places`):
+            ``"mix"`` (default: each event weighted over body, rim and shoulder by the
+            full-shape table's counts for its partner; P is the expectation over them) or
+            ``"body"``, ``"rim"``, ``"shoulder"`` (every event there).
         flaw_depth: depth of the outer surface's flaws, m, at which the contact-edge tension
             is felt (:mod:`demfem.stress.flaw_depth`): ``"characteristic"`` (default: the flaw
             that fails at the outer surface's σ_0, c = (K_Ic/(1.12 σ_0))²/π, ≈ 30 µm for the
@@ -208,6 +213,11 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
     if pair_geometry not in PAIR_GEOMETRIES:
         raise InvalidParameterError(f"invalid pair_geometry = {pair_geometry!r}: must be one "
                                     f"of {PAIR_GEOMETRIES}")
+    from demfem.assess.places import PLACE_MODES
+
+    if place not in PLACE_MODES:
+        raise InvalidParameterError(f"invalid place = {place!r}: must be one of "
+                                    f"{', '.join(map(repr, PLACE_MODES))}")
     e_stress = float(table.young_modulus) if stress_young_modulus is None else check_positive(
         "stress_young_modulus", stress_young_modulus)
     scg = SCG_BOROSILICATE if slow_crack_growth else None
@@ -234,7 +244,7 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
                 "until_steady": rule.to_dict() if rule else None, "throughput_per_hour": q,
                 "stress_young_modulus_Pa": e_stress,
                 "stress_model": model.to_dict() if isinstance(model, StressModel) else model,
-                "pair_geometry": pair_geometry,
+                "pair_geometry": pair_geometry, "place": place,
                 "slow_crack_growth": dataclasses.asdict(scg) if scg else None,
                 "inner_surface": dataclasses.asdict(surfaces["inner"]),
                 "outer_surface": dataclasses.asdict(surfaces["outer"]),
@@ -249,7 +259,7 @@ def assess(scene: Any = None, out: str | Path = "demfem_out/assess",
                      pair_geometry=pair_geometry, stress_young_modulus=e_stress,
                      slow_crack_growth=scg, surfaces=surfaces, flaw_depth=c_flaw, csv=csv,
                      threads=threads, checkpoint_every=checkpoint_every, fresh=fresh,
-                     progress=progress, seed=seed)
+                     progress=progress, seed=seed, place=place)
     # the folder's lock is held from here to the end, released on return or error
     book = StageBook(ctx.out, settings, fresh, OUTPUT_FILES)
     try:

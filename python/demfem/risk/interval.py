@@ -394,6 +394,7 @@ def hourly_interval_from_events(events: NDArray[Any], p_event: NDArray[np.float6
                                 window: tuple[float, float], period: float, *,
                                 wall_names: Sequence[str] = (),
                                 p_surfaces: Optional[Mapping[str, NDArray[np.float64]]] = None,
+                                components: Optional[Mapping[str, NDArray[np.float64]]] = None,
                                 scale: float = 3600.0, confidence: float = 0.95,
                                 method: str = "log-t", n_boot: int = 2000, seed: int = 0,
                                 max_weight: Optional[float] = None) -> RateInterval:
@@ -413,6 +414,10 @@ def hourly_interval_from_events(events: NDArray[Any], p_event: NDArray[np.float6
         p_surfaces: optional mapping surface → (n,) P_k,surface with
             1 − P_k = Π_s (1 − P_k,s) (``{"inner": p_inner, "outer": p_outer}``): their
             hazards add up to h_k exactly.
+        components: optional mapping name → (n,) hazards (the cartridges loaded counted)
+            whose sum over the names is each event's h_k (e.g. by place on the cartridge and
+            surface, :func:`demfem.assess.risk_stage.hazard_components`); instead of
+            ``p_surfaces``, as the grouping ``"component"``.
         scale: per second → reported unit (3600: per hour; pass broken_per_hour /
             (Σ h / W) to carry the interval onto a number computed otherwise).
         confidence, method, n_boot, seed, max_weight: as :func:`rate_interval`.
@@ -428,8 +433,15 @@ def hourly_interval_from_events(events: NDArray[Any], p_event: NDArray[np.float6
     names = np.array(list(wall_names) + ["wall"], dtype=object)
     place = np.where(partner == "sphere", "cartridge",
                      names[np.where((wall >= 0) & (wall < len(wall_names)), wall, -1)])
-    if p_surfaces:
-        weights: Any = {str(k): -np.log1p(-as_array(f"p_surfaces[{k!r}]", v, 0.0, 1.0,
+    if components is not None and p_surfaces:
+        raise InvalidParameterError("invalid components: give components or p_surfaces, "
+                                    "not both")
+    if components is not None:
+        weights: Any = {str(k): as_array(f"components[{k!r}]", v, 0.0, math.inf,
+                                         lo_open=False, ndim=1)
+                        for k, v in components.items()}
+    elif p_surfaces:
+        weights = {str(k): -np.log1p(-as_array(f"p_surfaces[{k!r}]", v, 0.0, 1.0,
                                                     lo_open=False, ndim=1)) * loads
                         for k, v in p_surfaces.items()}
     else:

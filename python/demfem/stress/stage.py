@@ -24,6 +24,16 @@ The equivalent spheres of the DEM carry no axis, so the geometry is an assumptio
 the report; ``model="shell"`` gives the former shell-only model
 (:class:`demfem.stress.StressModel`, σ1 = β F/t²) for comparison.
 
+**Places on the cartridge** (``place_weights``, :mod:`demfem.assess.places`): nor do the
+spheres carry a height. Given each event's probabilities of landing on the body, at the rim
+or at the shoulder, the stresses are computed at every place with a weight
+(``location`` of :func:`demfem.stress.contact_stresses`) into the ``*_by_place`` arrays
+(n, 3), and the one-value fields are those of the event's worst place (the largest outer σ1
+among the places it may land on; ``place_index``). The risk stage takes the expectation
+over the places. Only point contacts (:data:`POINT_GEOMETRIES`: crossed cartridges) have a
+model at the rim and the shoulder; line contacts (walls and gate, and pairs with
+``pair_geometry="parallel"``) take the body's model at every place, as the report states.
+
 SI units: m/s, N, m, s, Pa, m².
 """
 from __future__ import annotations
@@ -36,13 +46,19 @@ from demfem.assess.impact import ImpactLaw, cartridge_body, flat_partner
 from demfem.errors import InvalidParameterError, check_positive, check_range
 from demfem.stress.stress_model import StressModel
 
-__all__ = ["collision_stresses", "STRESS_FIELDS", "PAIR_GEOMETRIES", "STRESS_MODELS",
-           "characteristic_flaw_depth", "FRACTURE_TOUGHNESS"]
+__all__ = ["collision_stresses", "STRESS_FIELDS", "PLACE_FIELDS", "PAIR_GEOMETRIES",
+           "STRESS_MODELS", "characteristic_flaw_depth", "FRACTURE_TOUGHNESS"]
 
 #: Arrays of the stress stage, one value per event (units in the names).
 STRESS_FIELDS = ("force_N", "tangential_force_N", "contact_radius_m", "duration_s",
                  "sigma_inner_Pa", "sigma_outer_Pa", "area_inner_m2", "area_outer_m2",
                  "law_force_N", "sigma_outer_contact_Pa", "sigma_outer_bending_Pa", "p0_Pa")
+#: Contact geometries whose stresses have a model at the rim and the shoulder (point
+#: contacts, :mod:`demfem.stress.place_factors`); line contacts take the body's everywhere.
+POINT_GEOMETRIES = ("crossed", "edge")
+#: The fields computed per place when place weights are given: ``<field>_by_place``, (n, 3).
+PLACE_FIELDS = ("sigma_inner_Pa", "sigma_outer_Pa", "area_inner_m2", "area_outer_m2",
+                "sigma_outer_contact_Pa", "sigma_outer_bending_Pa", "p0_Pa")
 
 #: Fracture toughness K_Ic of the glass, Pa √m: 0.75 MPa √m, soda-lime and borosilicate
 #: glasses 0.7–0.8 (Wiederhorn 1969, J. Am. Ceram. Soc. 52, 99; Lawn 1993, Table 2.2).
@@ -102,7 +118,8 @@ def collision_stresses(normal_speed: np.ndarray, partner: np.ndarray, young_modu
                        pair_geometry: str = "crossed", friction: Optional[float] = None,
                        weibull_modulus_inner: Optional[float] = None,
                        weibull_modulus_outer: Optional[float] = None,
-                       flaw_depth: Optional[float] = None) -> dict[str, np.ndarray]:
+                       flaw_depth: Optional[float] = None,
+                       place_weights: Optional[np.ndarray] = None) -> dict[str, np.ndarray]:
     """Loads and stresses of collisions (module docstring).
 
     Args:
@@ -124,9 +141,14 @@ def collision_stresses(normal_speed: np.ndarray, partner: np.ndarray, young_modu
             :data:`demfem.risk.INNER_SURFACE`, :data:`demfem.risk.OUTER_SURFACE`).
         flaw_depth: depth of the outer surface's flaws, m: the contact-edge tension is taken
             as the flaws feel it (:mod:`demfem.stress.flaw_depth`); None: the surface value.
+        place_weights: (n, 3) probabilities of each event's place on the cartridge, in
+            :data:`demfem.stress.model.LOCATIONS` order (body, rim, shoulder; rows sum to 1;
+            :mod:`demfem.assess.places`); None: every event on the body.
 
     Returns:
-        The :data:`STRESS_FIELDS` arrays.
+        The :data:`STRESS_FIELDS` arrays; with ``place_weights``, also ``place_weight``
+        (n, 3), ``place_index`` (n,: the worst place, whose values the one-value fields
+        hold) and the ``<field>_by_place`` arrays (n, 3) of :data:`PLACE_FIELDS`.
     """
     from demfem.cartridge import Cartridge
 
@@ -149,6 +171,7 @@ def collision_stresses(normal_speed: np.ndarray, partner: np.ndarray, young_modu
             raise InvalidParameterError(f"invalid {name}: must have the shape of normal_speed "
                                         f"{v.shape}")
         measured.append(a)
+    weights = _place_weights(place_weights, v.shape)
     out = {k: np.zeros(v.shape) for k in STRESS_FIELDS}
     _loads(v, code, laws, measured[0], measured[1], out)
     f = out["force_N"]
@@ -167,6 +190,12 @@ def collision_stresses(normal_speed: np.ndarray, partner: np.ndarray, young_modu
         out["sigma_outer_contact_Pa"][:] = np.nan
         out["sigma_outer_bending_Pa"][:] = np.nan
         out["p0_Pa"][:] = np.nan
+        if weights is not None:
+            # the shell-only model has no place: the same stresses wherever the event lands
+            for k in PLACE_FIELDS:
+                out[f"{k}_by_place"] = np.repeat(out[k][:, None], weights.shape[1], axis=1)
+            out["place_weight"] = weights
+            out["place_index"] = np.argmax(weights > 0, axis=1).astype(np.int64)
         return out
     if model != "contact":
         raise InvalidParameterError(f"invalid model = {model!r}: must be one of {STRESS_MODELS} "
@@ -174,16 +203,67 @@ def collision_stresses(normal_speed: np.ndarray, partner: np.ndarray, young_modu
     if pair_geometry not in PAIR_GEOMETRIES:
         raise InvalidParameterError(f"invalid pair_geometry = {pair_geometry!r}: must be one "
                                     f"of {PAIR_GEOMETRIES}")
-    _contact_model(out, f, q, code, cart, body, e_wall, pair_geometry, friction,
-                   weibull_modulus_inner, weibull_modulus_outer, flaw_depth)
+    if weights is None:
+        _contact_model(out, f, q, code, cart, body, e_wall, pair_geometry, friction,
+                       weibull_modulus_inner, weibull_modulus_outer, flaw_depth)
+        return out
+    _by_place(out, weights, f, q, code, cart, body, e_wall, pair_geometry, friction,
+              weibull_modulus_inner, weibull_modulus_outer, flaw_depth)
     return out
+
+
+def _place_weights(w: Any, shape: tuple[int, ...]) -> Optional[np.ndarray]:
+    """``place_weights`` checked: (n, 3) finite, ≥ 0, rows summing to 1."""
+    from demfem.stress.model import LOCATIONS
+
+    if w is None:
+        return None
+    a = np.asarray(w, float)
+    if a.shape != shape + (len(LOCATIONS),):
+        raise InvalidParameterError(f"invalid place_weights: shape {a.shape} must be "
+                                    f"{shape + (len(LOCATIONS),)} (one row of {LOCATIONS} per "
+                                    "event)")
+    if np.any(~np.isfinite(a)) or np.any(a < 0) or np.any(np.abs(a.sum(axis=1) - 1.0) > 1e-9):
+        raise InvalidParameterError("invalid place_weights: every row must be finite "
+                                    "fractions >= 0 summing to 1")
+    return a
+
+
+def _by_place(out: dict[str, np.ndarray], weights: np.ndarray, f: np.ndarray, q: np.ndarray,
+              code: np.ndarray, cart: Any, body: Any, e_wall: float, pair_geometry: str,
+              friction: Optional[float], m_inner: Optional[float], m_outer: Optional[float],
+              flaw_depth: Optional[float]) -> None:
+    """The contact model at every place an event may land on (weight > 0); the one-value
+    fields from each event's worst place (largest outer σ1, then the first place)."""
+    from demfem.stress.model import LOCATIONS
+
+    n = len(f)
+    by = {k: np.zeros((n, len(LOCATIONS))) for k in PLACE_FIELDS}
+    for j, place in enumerate(LOCATIONS):
+        sel = weights[:, j] > 0
+        if not np.any(sel):
+            continue
+        part = {k: np.zeros(int(sel.sum())) for k in STRESS_FIELDS}
+        _contact_model(part, f[sel], q[sel], code[sel], cart, body, e_wall, pair_geometry,
+                       friction, m_inner, m_outer, flaw_depth, location=place)
+        for k in PLACE_FIELDS:
+            by[k][sel, j] = part[k]
+    outer = np.where(weights > 0, by["sigma_outer_Pa"], -np.inf)
+    worst = np.argmax(outer, axis=1).astype(np.int64)
+    rows = np.arange(n)
+    for k in PLACE_FIELDS:
+        out[k] = by[k][rows, worst]
+        out[f"{k}_by_place"] = by[k]
+    out["place_weight"] = weights
+    out["place_index"] = worst
 
 
 def _contact_model(out: dict[str, np.ndarray], f: np.ndarray, q: np.ndarray, code: np.ndarray,
                    cart: Any, body: Any, e_wall: float, pair_geometry: str,
                    friction: Optional[float], m_inner: Optional[float],
-                   m_outer: Optional[float], flaw_depth: Optional[float]) -> None:
-    """The contact-stress model's fields of every event into ``out``."""
+                   m_outer: Optional[float], flaw_depth: Optional[float],
+                   location: str = "body") -> None:
+    """The contact-stress model's fields of every event into ``out`` (at ``location``)."""
     from dataclasses import replace
 
     from demfem.materials import Material
@@ -202,7 +282,9 @@ def _contact_model(out: dict[str, np.ndarray], f: np.ndarray, q: np.ndarray, cod
             continue
         r = contact_stresses(f[sel], q[sel], cartridge=cart, material=glass,
                              weibull_modulus_outer=m_outer, weibull_modulus_inner=m_inner,
-                             friction_coefficient=mu, flaw_depth=flaw_depth, **kw)
+                             friction_coefficient=mu, flaw_depth=flaw_depth,
+                             location=location if kw["geometry"] in POINT_GEOMETRIES
+                             else "body", **kw)
         out["sigma_outer_Pa"][sel] = r.outer_sigma1_max
         out["sigma_inner_Pa"][sel] = r.inner_sigma1_max
         out["area_outer_m2"][sel] = r.outer_effective_area
