@@ -180,3 +180,21 @@ def test_synthetic_pulse_is_smoothed_then_evaluated():
     assert peaks["outer_sigma1_Pa"] == pytest.approx(float(direct.outer_sigma1_max.max()),
                                                      rel=1e-12)
     assert sub.summary()["pairs"]["1-3_top"]["inner_sigma1_Pa"] == 0.0
+
+
+def test_tangential_force_above_coulomb_is_clipped_and_counted():
+    """Q above μ F (the run's Coulomb limit, 0.2) is clipped to μ F: by roundoff silently
+    (it is the limit), beyond roundoff counted; the closed form never sees Q > μ F."""
+    c = CartridgeCluster.load_case("max", elements="shell")
+    t = np.arange(0, 5e-4, 2.5e-5)  # samples 25 us apart: no smoothing
+    f = np.linspace(1.0, 10.0, len(t))
+    q = 0.2 * f * (1 + 1e-13)
+    q[::4] = 0.3 * f[::4]
+    data = {f"{k}_1{p}_{r}": np.zeros_like(t) for k in ("fn", "ft") for p in "23"
+            for r in ("bottom", "top")}
+    data.update({"time": t, "fn_13_top": f, "ft_13_top": q})
+    h = evaluate_submodel(c, data).histories["1-3_top"]
+    assert h.clipped_tangential == len(t[::4])
+    assert h.max_friction_ratio == pytest.approx(0.3)
+    assert np.all(h.tangential_force <= 0.2 * h.normal_force)
+    assert np.all(h.inner_sigma1 > 0)

@@ -286,8 +286,8 @@ def evaluate_submodel(cluster: CartridgeCluster, data: dict) -> ClusterSubmodel:
             on = f > 0
             ratio = np.zeros_like(f)
             ratio[on] = q[on] / f[on]
-            over = on & (q > mu * f * (1.0 + 1e-9))
-            q = np.where(over, mu * f, q)
+            over = on & (q > mu * f * (1.0 + 1e-9))  # counted: beyond roundoff
+            q = np.minimum(q, mu * f)
             q[~on] = 0.0
             zeros = [np.zeros_like(f) for _ in range(4)]
             model_loc, in_range = "body", geo[key].location == "body"

@@ -158,7 +158,14 @@ class ClusterParts:
 class CartridgeCluster:
     """Cartridge 1 in the middle of 2-7 on the belt; 2 and 3 hit it (see the module text
     for the frame and every rule). SI units; angles in degrees. Validated on creation:
-    a bad field raises :class:`demfem.errors.InvalidParameterError` naming it."""
+    a bad field raises :class:`demfem.errors.InvalidParameterError` naming it.
+
+    ``tilt_2_deg``, ``tilt_3_deg`` (degrees, [-10, 10]): the hitter's axis turned about
+    z × heading; > 0 the top leans forward and its shoulder edge hits 1 first, < 0 the top
+    leans back and its open end's edge hits first. ``offset_2_z``, ``offset_3_z`` (m,
+    [0, length/2]): its lowest glass point ``lift + offset`` above the belt. Either keeps
+    the start gap ``impact_gap`` to 1 (the hitter is moved along its site direction) and is
+    refused if any two cartridges would overlap at t = 0."""
 
     case: str = "max"
     v2: float = 0.18
