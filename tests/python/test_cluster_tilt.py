@@ -142,3 +142,25 @@ def test_cli_reads_tilt_from_a_scene_file(tmp_path, capsys):
     assert main(["cluster", "--case", str(bad), "--out", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err
     assert "tilt_2_deg" in err and err.count("\n") == 1
+
+
+def test_cli_runs_a_tilted_scene_file(tmp_path, capsys):
+    """demfem cluster --case SCENE.toml with a tilt: the run is of the tilted scene (its
+    settings record it) and 2's force is on 1's bottom half only."""
+    from demfem.cli import main
+
+    c = CartridgeCluster.load_case("max", cartridge=TUBE, elements="shell", tilt_2_deg=-5.0,
+                                   v3=0.0)
+    scene = c.to_toml(tmp_path / "tilted.toml")
+    out = tmp_path / "out"
+    assert main(["cluster", "--case", str(scene), "--duration", "3e-4", "--snapshots", "2",
+                 "--out", str(out)]) == 0
+    capsys.readouterr()
+    import json
+
+    record = json.loads((out / "settings.json").read_text())
+    assert record["settings"]["cluster"]["tilt_2_deg"] == -5.0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["force_peaks"]["1-2_bottom"]["normal_N"] > 0
+    assert summary["force_peaks"]["1-2_top"]["normal_N"] == 0.0
+    assert summary["submodel"]["pairs"]["1-2_bottom"]["geometry"] == "crossed"
