@@ -4,7 +4,7 @@
 them, and the model against the FEM at the place.
 
     python benches/stress_place_tables.py                  # run what is missing, factors, table
-    python benches/stress_place_tables.py --only run       # the FEM cases only (≈ 20 min)
+    python benches/stress_place_tables.py --only run       # the FEM cases only (≈ 20 min, 22 cases)
     python benches/stress_place_tables.py --only factors   # python/demfem/stress/place_factors.json
     python benches/stress_place_tables.py --only markdown  # the tables, from the JSON
 
@@ -175,7 +175,7 @@ def factors(data: dict[str, Any]) -> dict[str, Any]:
 
 def write_factors(data: dict[str, Any]) -> dict[str, Any]:
     t = factors(data)
-    out = {
+    out: dict[str, Any] = {
         "description": "contact_stresses(location='rim'|'shoulder'): factors on the model's "
                        "global terms, k = FEM(place) / FEM(body) on the same grading "
                        "(demfem.stress.place_fem, benches/stress_place_tables.py), per normal "
