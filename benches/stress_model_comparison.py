@@ -18,6 +18,7 @@ the same events:
 
     python benches/stress_model_comparison.py [--duration 6] [--out demfem_out/model_cmp]
     python benches/stress_model_comparison.py --folder RUN   # one existing folder's events
+    python benches/stress_model_comparison.py --reuse        # the belt speeds' folders again
 
 Writes ``docs/data/stress_model_comparison.json`` and prints a table. SI units; hourly
 numbers per hour.
@@ -30,6 +31,7 @@ import json
 import math
 import time
 from pathlib import Path
+from typing import Optional
 
 import numpy as np
 
@@ -107,6 +109,9 @@ def main() -> None:
     ap.add_argument("--speeds", default="0.1,0.2,0.3", help="belt speeds, m/s")
     ap.add_argument("--out", default="demfem_out/model_cmp")
     ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--reuse", action="store_true",
+                    help="evaluate the belt speeds' folders under --out that already hold "
+                         "their events.npz instead of running their DEM again")
     ap.add_argument("--folder", default=None,
                     help="instead of running the belt speeds: evaluate the variants on one "
                          "assessment folder of the default table that still holds its "
@@ -135,12 +140,16 @@ def main() -> None:
         table = dataclasses.replace(AccumulationTable(), belt_velocity=v, refeed=True)
         out = Path(args.out) / f"belt_{v:g}"
         start = time.perf_counter()
-        assess(table, out=out, duration=args.duration, discard_before=min(2.0, args.duration / 2),
-               stop_after="events", threads=args.threads, log=lambda _: None)
-        dem_s = time.perf_counter() - start
+        dem_s: Optional[float] = None
+        if not (args.reuse and (out / "events.npz").is_file()):
+            assess(table, out=out, duration=args.duration,
+                   discard_before=min(2.0, args.duration / 2), stop_after="events",
+                   threads=args.threads, log=lambda _: None)
+            dem_s = time.perf_counter() - start
         rows[v] = {"dem_wall_s": dem_s, **{name: evaluate(out, table, var)
                                             for name, var in VARIANTS.items()}}
-        print(f"belt {v:g} m/s: DEM {dem_s:.0f} s", flush=True)
+        print(f"belt {v:g} m/s: " + (f"DEM {dem_s:.0f} s" if dem_s is not None else
+                                     "DEM reused"), flush=True)
     print(f"\n{'model':32s} " + " ".join(f"{'belt ' + format(v, 'g') + ' m/s':>34s}"
                                         for v in rows))
     for name in VARIANTS:
@@ -158,7 +167,7 @@ def main() -> None:
            "variants": {k: {kk: str(vv) for kk, vv in v.items()} for k, v in VARIANTS.items()},
            "belt_speeds": {str(v): r for v, r in rows.items()},
            "command": "python benches/stress_model_comparison.py --duration "
-                      f"{args.duration:g}"}
+                      f"{args.duration:g}" + (" --reuse" if args.reuse else "")}
     path = Path(__file__).resolve().parents[1] / "docs" / "data" / "stress_model_comparison.json"
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(json.dumps(doc, indent=1, default=float) + "\n")

@@ -147,17 +147,20 @@ def make_figures(out: Path, data: dict[str, Any]) -> dict[str, bytes]:
     curves = data.get("stress_curves")
     if curves is not None:
         fc = np.asarray(curves["force_N"], float)
+        at = f" at the {curves['place']}" if curves.get("place") else ""
         ax.plot(fc, np.asarray(curves["sigma_outer_sliding_Pa"]) / 1e6, color="C0", lw=1,
-                label=f"outer, two cartridges sliding at μ = {curves['friction']:g}", zorder=1)
+                label=f"outer{at}, two cartridges sliding at μ = {curves['friction']:g}",
+                zorder=1)
         ax.plot(fc, np.asarray(curves["sigma_outer_Pa"]) / 1e6, color="C0", lw=1, ls="--",
                 label="outer, no friction", zorder=1)
         ax.plot(fc, np.asarray(curves["sigma_inner_Pa"]) / 1e6, color="C3", lw=1,
                 label="inner (bending)", zorder=1)
     wall = inside & (ev["partner"] == 1)
     pair = inside & (ev["partner"] == 0)
+    worst = " (worst place)" if "place_index" in st else ""
     for sel, marker, who in ((pair, ".", "cartridges"), (wall, "x", "walls, gate")):
         ax.scatter(st["force_N"][sel], st["sigma_outer_Pa"][sel] / 1e6, s=4, marker=marker,
-                   color="C0", alpha=0.5, zorder=3, label=f"events with {who}: outer")
+                   color="C0", alpha=0.5, zorder=3, label=f"events with {who}: outer{worst}")
         ax.scatter(st["force_N"][sel], st["sigma_inner_Pa"][sel] / 1e6, s=4, marker=marker,
                    color="C3", alpha=0.5, zorder=3, label=f"events with {who}: inner")
     ax.set_xscale("log")

@@ -87,12 +87,14 @@ def _calibration_stresses(forces: np.ndarray, table, e_stress: float, model: Any
                           flaw_depth: Optional[float] = None,
                           place: str = "body") -> dict[str, Any]:
     """σ1 outside and inside of two cartridges at the calibration's ``forces`` (N), without
-    friction and sliding at the table's μ (Pa), at Young's modulus ``e_stress`` (Pa), at the
-    worst place a contact between cartridges may land on (``place``,
-    :mod:`demfem.assess.places`)."""
-    from demfem.assess.places import pair_place_weights
+    friction and sliding at the table's μ (Pa), at Young's modulus ``e_stress`` (Pa), at one
+    place on the cartridge (``place``; for ``"mix"`` the likeliest place of a contact between
+    cartridges, :mod:`demfem.assess.places`), named in ``place``."""
+    from demfem.assess.places import PLACE_WEIGHTS, PLACES, pair_place_weights
     from demfem.stress.stage import collision_stresses
 
+    if place == "mix":
+        place = PLACES[int(np.argmax(PLACE_WEIGHTS["weights"]["cartridge"]))]
     f = np.asarray(forces, float)
     kw = dict(model=model, cartridge=table.cartridge, pair_geometry=pair_geometry,
               friction=table.friction, weibull_modulus_inner=surfaces["inner"].weibull_modulus,
@@ -106,7 +108,7 @@ def _calibration_stresses(forces: np.ndarray, table, e_stress: float, model: Any
                                measured_impulse=f * 1e-4, measured_tangential=table.friction * f,
                                **kw)
     return {"sigma_outer_Pa": still["sigma_outer_Pa"], "sigma_inner_Pa": still["sigma_inner_Pa"],
-            "sigma_outer_sliding_Pa": slide["sigma_outer_Pa"]}
+            "sigma_outer_sliding_Pa": slide["sigma_outer_Pa"], "place": place}
 
 
 def _event_min_force(table, e_stress: float, v_min: float) -> float:
@@ -216,11 +218,13 @@ class CalibrationStage(Stage):
         log("  v_n [m/s]: " + " ".join(f"{v:g}" for v in cal["speeds_m_per_s"]))
         log("  F [N]:     " + " ".join(f"{f:.3g}" for f in cal["force_N"]))
         log("  stress model: " + _model_words(ctx.model, ctx.pair_geometry))
-        log("  sigma1 outer [MPa], no friction / at mu = "
+        at = f" at the {cal['place']}" if "place" in cal else ""
+        log(f"  sigma1 outer [MPa]{at}, no friction / at mu = "
             f"{ctx.table.friction:g}: " + " ".join(
                 f"{a / 1e6:.3g}/{b / 1e6:.3g}" for a, b in zip(cal["sigma_outer_Pa"],
                                                               cal["sigma_outer_sliding_Pa"])))
-        log("  sigma1 inner [MPa]: " + " ".join(f"{a / 1e6:.3g}" for a in cal["sigma_inner_Pa"]))
+        log(f"  sigma1 inner [MPa]{at}: " + " ".join(f"{a / 1e6:.3g}"
+                                                     for a in cal["sigma_inner_Pa"]))
 
 
 class DemStage(Stage):
