@@ -23,6 +23,8 @@ CASES = {
     "crossed 45 deg": "dict(crossing_angle_deg=45.0)",
     "wall, line contact 40 mm": "dict(geometry='wall', contact_length=0.04)",
     "crossed 90 deg, flaw depth 20 um": "dict(flaw_depth=20e-6)",
+    "crossed 90 deg at the rim": "dict(location='rim')",
+    "crossed 90 deg at the shoulder": "dict(location='shoulder')",
 }
 
 _CHILD = """
