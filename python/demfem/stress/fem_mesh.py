@@ -41,6 +41,7 @@ __all__ = [
     "surface_coordinates",
     "size_expression",
     "mesh_stats",
+    "generate_graded",
 ]
 
 
@@ -344,6 +345,50 @@ def signed_volume(X: np.ndarray, T: np.ndarray) -> np.ndarray:
     return np.einsum("ij,ij->i", np.cross(b - a, c - a), d - a) / 6.0
 
 
+
+def generate_graded(expr: str, grading: Grading, order: int = 1, algorithm_3d: int = 1,
+                    threads: int = 1) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Mesh the open gmsh model (its geometry synchronised) with the MathEval size field
+    ``expr`` (:func:`size_expression`) as the only size source, bounded by ``grading``'s
+    smallest and far sizes: tets of ``order`` 1 or 2, gmsh's 3-D ``algorithm_3d`` on
+    ``threads``. Returns the nodes X (m), the tets T (rows of node indices), each tet's
+    minSICN quality and the map from gmsh node tags to indices. Refused
+    (InvalidParameterError naming the grading): a grading gmsh cannot mesh, or no tets."""
+    import gmsh
+
+    g = grading
+    fld = gmsh.model.mesh.field.add("MathEval")
+    gmsh.model.mesh.field.setString(fld, "F", expr)
+    gmsh.model.mesh.field.setAsBackgroundMesh(fld)
+    for k in ("Mesh.MeshSizeExtendFromBoundary", "Mesh.MeshSizeFromPoints",
+              "Mesh.MeshSizeFromCurvature"):
+        gmsh.option.setNumber(k, 0)
+    gmsh.option.setNumber("Mesh.MeshSizeMin", 0.5 * min(g.contact_size, g.edge_size))
+    gmsh.option.setNumber("Mesh.MeshSizeMax", g.far_size)
+    gmsh.option.setNumber("Mesh.Algorithm", 6)
+    gmsh.option.setNumber("Mesh.Algorithm3D", algorithm_3d)
+    gmsh.option.setNumber("General.NumThreads", int(threads))
+    gmsh.option.setNumber("Mesh.ElementOrder", order)
+    gmsh.option.setNumber("Mesh.SecondOrderLinear", 0)
+    try:
+        gmsh.model.mesh.generate(3)
+    except Exception as e:  # gmsh raises plain Exception
+        raise InvalidParameterError(
+            f"invalid grading.contact_size = {g.contact_size!r} m: gmsh could not mesh "
+            f"this grading ({e})") from None
+    tags, xyz, _ = gmsh.model.mesh.getNodes()
+    tags = tags.astype(np.int64)
+    index = np.full(int(tags.max()) + 1, -1, dtype=np.int64)
+    index[tags] = np.arange(len(tags))
+    X = xyz.reshape(-1, 3).copy()
+    etags, enodes = gmsh.model.mesh.getElementsByType(4 if order == 1 else 11)
+    T = index[enodes.astype(np.int64)].reshape(-1, 4 if order == 1 else 10)
+    if len(T) == 0:
+        raise InvalidParameterError(
+            f"invalid grading.contact_size = {g.contact_size!r} m: gmsh made no tets")
+    q = np.asarray(gmsh.model.mesh.getElementQualities(etags, "minSICN"), float)
+    return X, T, q, index
+
 def build_mesh(body: Body, patch: HertzPatch, grading: Optional[Grading] = None, *,
                order: int = 1, opposite: bool = False, conforming_rim: Optional[bool] = None,
                max_elements: float = 2.0e6, threads: int = 1, min_quality: float = 0.01,
@@ -437,38 +482,8 @@ def build_mesh(body: Body, patch: HertzPatch, grading: Optional[Grading] = None,
             occ.fragment([(d, t) for d, t in occ.getEntities(3) if (d, t) not in pieces],
                          pieces)
         occ.synchronize()
-        fld = gmsh.model.mesh.field.add("MathEval")
-        gmsh.model.mesh.field.setString(fld, "F", expr)
-        gmsh.model.mesh.field.setAsBackgroundMesh(fld)
-        for k in ("Mesh.MeshSizeExtendFromBoundary", "Mesh.MeshSizeFromPoints",
-                  "Mesh.MeshSizeFromCurvature"):
-            gmsh.option.setNumber(k, 0)
-        gmsh.option.setNumber("Mesh.MeshSizeMin", 0.5 * min(g.contact_size, g.edge_size))
-        gmsh.option.setNumber("Mesh.MeshSizeMax", g.far_size)
-        gmsh.option.setNumber("Mesh.Algorithm", 6)
-        gmsh.option.setNumber("Mesh.Algorithm3D", algorithm_3d)
-        gmsh.option.setNumber("General.NumThreads", int(threads))
-        gmsh.option.setNumber("Mesh.ElementOrder", order)
-        gmsh.option.setNumber("Mesh.SecondOrderLinear", 0)
-        try:
-            gmsh.model.mesh.generate(3)
-        except Exception as e:  # gmsh raises plain Exception
-            raise InvalidParameterError(
-                f"invalid grading.contact_size = {g.contact_size!r} m: gmsh could not mesh "
-                f"this grading ({e})") from None
-        tags, xyz, _ = gmsh.model.mesh.getNodes()
-        tags = tags.astype(np.int64)
-        index = np.full(int(tags.max()) + 1, -1, dtype=np.int64)
-        index[tags] = np.arange(len(tags))
-        X = xyz.reshape(-1, 3).copy()
-        etype = 4 if order == 1 else 11
-        etags, enodes = gmsh.model.mesh.getElementsByType(etype)
-        npe = 4 if order == 1 else 10
-        T = index[enodes.astype(np.int64)].reshape(-1, npe)
-        if len(T) == 0:
-            raise InvalidParameterError(
-                f"invalid grading.contact_size = {g.contact_size!r} m: gmsh made no tets")
-        q = gmsh.model.mesh.getElementQualities(etags, "minSICN")
+        X, T, q, index = generate_graded(expr, g, order, algorithm_3d, threads)
+        npe = T.shape[1]
         ftype = 2 if order == 1 else 9
         outer_f, inner_f = [], []
         for dim, stag in gmsh.model.getEntities(2):

@@ -63,6 +63,7 @@ from demfem.stress.fem_mesh import (
     ResolvedMesh,
     TubeSegment,
     estimate_elements,
+    generate_graded,
     mesh_stats,
     signed_volume,
     size_expression,
@@ -223,35 +224,8 @@ def build_place_mesh(patch: HertzPatch, place: str, *, cartridge: Any = None,
         occ.rotate(vols, 0, 0, 0, 0, 0, 1, -0.5 * math.pi)
         occ.translate(vols, 0, 0, -zc)
         occ.synchronize()
-        fld = gmsh.model.mesh.field.add("MathEval")
-        gmsh.model.mesh.field.setString(fld, "F", expr)
-        gmsh.model.mesh.field.setAsBackgroundMesh(fld)
-        for k in ("Mesh.MeshSizeExtendFromBoundary", "Mesh.MeshSizeFromPoints",
-                  "Mesh.MeshSizeFromCurvature"):
-            gmsh.option.setNumber(k, 0)
-        gmsh.option.setNumber("Mesh.MeshSizeMin", 0.5 * min(g.contact_size, g.edge_size))
-        gmsh.option.setNumber("Mesh.MeshSizeMax", g.far_size)
-        gmsh.option.setNumber("Mesh.Algorithm", 6)
-        gmsh.option.setNumber("Mesh.Algorithm3D", 1)
-        gmsh.option.setNumber("General.NumThreads", 1)
-        gmsh.option.setNumber("Mesh.ElementOrder", 1)
-        try:
-            gmsh.model.mesh.generate(3)
-        except Exception as e:  # gmsh raises plain Exception
-            raise InvalidParameterError(
-                f"invalid grading.contact_size = {g.contact_size!r} m: gmsh could not mesh "
-                f"this grading ({e})") from None
-        tags, xyz, _ = gmsh.model.mesh.getNodes()
-        tags = tags.astype(np.int64)
-        index = np.full(int(tags.max()) + 1, -1, dtype=np.int64)
-        index[tags] = np.arange(len(tags))
-        X = xyz.reshape(-1, 3).copy()
-        etags, enodes = gmsh.model.mesh.getElementsByType(4)
-        T = index[enodes.astype(np.int64)].reshape(-1, 4)
-        if len(T) == 0:
-            raise InvalidParameterError(f"invalid grading.contact_size = {g.contact_size!r} "
-                                        "m: gmsh made no tets")
-        qmin = float(np.min(gmsh.model.mesh.getElementQualities(etags, "minSICN")))
+        X, T, q, index = generate_graded(expr, g, order=1, algorithm_3d=1, threads=1)
+        qmin = float(np.min(q))
         groups: dict[str, list[np.ndarray]] = {"outer": [], "inner": [], "other_outer": [],
                                                "other_inner": []}
         tol = 1e-6 * R
