@@ -116,6 +116,11 @@ def test_the_risk_is_the_expectation_over_places():
     st = _stresses(w)
     for k in PLACE_FIELDS:
         assert st[f"{k}_by_place"].shape == (6, 3)
+    # point contacts (the pairs) differ by place; line contacts (walls) take the body's
+    so = st["sigma_outer_Pa_by_place"]
+    assert np.all(so[:4, 1] > so[:4, 0]) and np.all(st["sigma_inner_Pa_by_place"][:4, 2]
+                                                      < st["sigma_inner_Pa_by_place"][:4, 0])
+    assert np.array_equal(so[4:, 1], so[4:, 0])
     # the one-value fields are the worst place's (largest outer sigma1 among those possible)
     rows = np.arange(6)
     possible = np.where(w > 0, st["sigma_outer_Pa_by_place"], -np.inf)

@@ -30,7 +30,7 @@ or at the shoulder, the stresses are computed at every place with a weight
 (``location`` of :func:`demfem.stress.contact_stresses`) into the ``*_by_place`` arrays
 (n, 3), and the one-value fields are those of the event's worst place (the largest outer σ1
 among the places it may land on; ``place_index``). The risk stage takes the expectation
-over the places. Only point contacts (:data:`POINT_GEOMETRIES`: crossed cartridges) have a
+over the places. Only point contacts (:data:`demfem.stress.model.PLACE_GEOMETRIES`) have a
 model at the rim and the shoulder; line contacts (walls and gate, and pairs with
 ``pair_geometry="parallel"``) take the body's model at every place, as the report states.
 
@@ -53,9 +53,6 @@ __all__ = ["collision_stresses", "STRESS_FIELDS", "PLACE_FIELDS", "PAIR_GEOMETRI
 STRESS_FIELDS = ("force_N", "tangential_force_N", "contact_radius_m", "duration_s",
                  "sigma_inner_Pa", "sigma_outer_Pa", "area_inner_m2", "area_outer_m2",
                  "law_force_N", "sigma_outer_contact_Pa", "sigma_outer_bending_Pa", "p0_Pa")
-#: Contact geometries whose stresses have a model at the rim and the shoulder (point
-#: contacts, :mod:`demfem.stress.place_factors`); line contacts take the body's everywhere.
-POINT_GEOMETRIES = ("crossed", "edge")
 #: The fields computed per place when place weights are given: ``<field>_by_place``, (n, 3).
 PLACE_FIELDS = ("sigma_inner_Pa", "sigma_outer_Pa", "area_inner_m2", "area_outer_m2",
                 "sigma_outer_contact_Pa", "sigma_outer_bending_Pa", "p0_Pa")
@@ -267,7 +264,7 @@ def _contact_model(out: dict[str, np.ndarray], f: np.ndarray, q: np.ndarray, cod
     from dataclasses import replace
 
     from demfem.materials import Material
-    from demfem.stress.model import contact_stresses
+    from demfem.stress.model import PLACE_GEOMETRIES, contact_stresses
 
     glass = replace(cart.material, E=body.E, nu=body.nu)
     wall = Material(E=e_wall, nu=body.nu, density=glass.density, name="wall")
@@ -283,7 +280,7 @@ def _contact_model(out: dict[str, np.ndarray], f: np.ndarray, q: np.ndarray, cod
         r = contact_stresses(f[sel], q[sel], cartridge=cart, material=glass,
                              weibull_modulus_outer=m_outer, weibull_modulus_inner=m_inner,
                              friction_coefficient=mu, flaw_depth=flaw_depth,
-                             location=location if kw["geometry"] in POINT_GEOMETRIES
+                             location=location if kw["geometry"] in PLACE_GEOMETRIES
                              else "body", **kw)
         out["sigma_outer_Pa"][sel] = r.outer_sigma1_max
         out["sigma_inner_Pa"][sel] = r.inner_sigma1_max
