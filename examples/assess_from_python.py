@@ -14,20 +14,22 @@ From the folder it prints the expected broken cartridges per hour with its 95 % 
 collision event, SI units in the column names), the hazard by partner (another cartridge, or
 the wall by name): each event's hazard −ln(1 − P) times the cartridges it loads (2 between
 cartridges, 1 against a wall or the gate), summed per partner over the statistics window, per
-hour and as a share.
+hour and as a share; and the hazard by place on the cartridge from the events' place terms
+(``p_event_rim`` …, which add up to ``p_event``), beside ``risk.json``'s ``place_share``.
 
 Run:  python examples/assess_from_python.py [OUT]     (default demfem_out/assess_example)
 
 What it prints after assess's own stage lines (2-core machine, shared; about 30 s):
 
     == the assessment read back from demfem_out/assess_example ==
-    expected broken cartridges per hour: 4.42e-05 (95 % interval 2.92e-06 - 0.000668, a factor 15.1 either way, over 4 gate periods); 9402 events in the window
+    expected broken cartridges per hour: 0.0103 (95 % interval 0.000456 - 0.231, a factor 22.5 either way, over 4 gate periods); 9402 events in the window
     hazard by partner (events table, t = 0.04 - 0.2 s):
                 events hazard per hour  share
-    cartridge     9049        3.83e-05 0.8684
-    gate            25        5.29e-06 0.1199
-    lower_side     142        4.84e-07 0.0110
-    tilted         186        3.06e-08 0.0007
+    cartridge     9049          0.0103 0.9996
+    gate            25        3.54e-06 0.0003
+    lower_side     142        3.23e-07 0.0000
+    tilted         186        2.04e-08 0.0000
+    hazard by place on the cartridge: rim 97.0%, body 1.3%, shoulder 1.7% (risk.json: body 1.3%, rim 97.0%, shoulder 1.7%)
 
 (the interval is wide: four gate periods of a table that has not settled; the default job's
 is a factor of about 1.2.)
@@ -75,6 +77,15 @@ def main(out: str = "demfem_out/assess_example") -> dict[str, float]:
     print(f"hazard by partner (events table, t = {t0:g} - {t1:g} s):")
     print(by.sort_values("share", ascending=False).to_string(
         formatters={"hazard per hour": "{:.3g}".format, "share": "{:.4f}".format}))
+    # 4. where on the cartridge: each event's terms w_p P_p by place add up to its P
+    places = ("rim", "body", "shoulder")
+    p_event = ev["p_event"].to_numpy()
+    frac = {pl: np.divide(ev[f"p_event_{pl}"].to_numpy(), p_event, out=np.zeros(len(ev)),
+                          where=p_event > 0) for pl in places}
+    total = hazard.sum()
+    print("hazard by place on the cartridge: " + ", ".join(
+        f"{pl} {float((hazard * frac[pl]).sum() / total):.1%}" for pl in places)
+        + f" (risk.json: {', '.join(f'{k} {v:.1%}' for k, v in s['place_share'].items())})")
     return {"broken_per_hour": s["broken_per_hour"], "lower": lo, "upper": hi,
             "cartridge_share": float(by["share"].get("cartridge", 0.0))}
 
