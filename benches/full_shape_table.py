@@ -4,9 +4,13 @@ angle, how many cartridges tilt or fall, and how the two engines' contact statis
 (issue 40, items 2 and 3).
 
 Both runs are the default table's geometry (840 cartridges, the gate swinging, the belt
-packing them) at the same Young's modulus, from the same start, **not re-fed** (the rigid
-engine removes cartridges through the outlet but cannot re-insert them; over a few seconds
-the table loses about 20 cartridges a second at its downstream end). The spheres run with the
+packing them) at the same Young's modulus, from the same start, **re-fed** by default: what
+leaves through the outlet is put back upstream at the first free re-feed site (cartridges
+upright, where the engine's exact contact test finds the site free:
+``RigidSimulation.reinsert_body``, :func:`demfem.dem.refeed_removed_bodies`), so the table
+runs "in operation" with a steady population instead of draining (about 20 cartridges a
+second leave at its downstream end). ``--no-refeed`` runs the draining table (the table then
+keeps its upstream column filled at the start, as before). The spheres run with the
 calibrated Hertz–Reissner–Mindlin law that ``demfem assess`` uses; the cartridges with Hertz
 at the local radii of the two surfaces (the rigid engine has no shell compliance).
 
@@ -19,7 +23,8 @@ every cartridge on the table. The sphere run gives the same onsets by partner.
 
     python benches/full_shape_table.py --duration 3.0 --warmup 2.0 --threads 2
 
-Results go to ``docs/data/full_shape_table.json`` (distributions as counts), and a summary to
+Every ``--sample`` seconds the cartridges on the table are counted (``tilt``: ``on_table``,
+and ``reinserted``, the re-insertions so far). Results go to ``docs/data/full_shape_table.json`` (distributions as counts), and a summary to
 stdout. The full-shape run costs about 20 times the spheres (docs/performance.md).
 """
 from __future__ import annotations
@@ -76,7 +81,9 @@ def full_shapes(table: AccumulationTable, a: argparse.Namespace) -> dict[str, An
     start = time.perf_counter()
     sim = rigid.from_scene(description, particle="revolution", record_onsets=True,
                            threads=a.threads)
-    print(f"revolution: {len(sim)} cartridges, dt {sim.dt:.3e} s", flush=True)
+    refeed = rigid.refeed_of(description) if a.refeed else None
+    print(f"revolution: {len(sim)} cartridges, dt {sim.dt:.3e} s, "
+          f"{'re-fed' if refeed else 'not re-fed'}", flush=True)
     cart = table.cartridge
     cols: dict[str, list[Any]] = {k: [] for k in (
         "time", "place_body", "place_partner", "partner", "axis_angle_deg", "normal_speed",
@@ -88,7 +95,7 @@ def full_shapes(table: AccumulationTable, a: argparse.Namespace) -> dict[str, An
             print(f"  stopped at t = {t:.2f} s: --max-wall {a.max_wall:g} s reached", flush=True)
             break
         t = min(a.duration, t + a.sample)
-        sim.run_until(t)
+        rigid.run(sim, t, refeed=refeed)
         ev = rigid.contact_places(sim, cart, description.walls)
         keep = (np.asarray(ev["time"]) >= a.warmup) & (
             np.asarray(ev["normal_speed"]) >= a.min_speed)
@@ -105,11 +112,13 @@ def full_shapes(table: AccumulationTable, a: argparse.Namespace) -> dict[str, An
         alive = np.asarray(sim.alive(), bool)
         tilt = np.degrees(np.asarray(sim.tilt_angles(), float))[alive]
         tilt_rows.append({"time_s": t, "on_table": int(alive.sum()),
+                          "reinserted": int(len(sim.reinsertions()[0])),
                           **{f"beyond_{x:g}_deg": int(np.count_nonzero(tilt > x))
                              for x in TILTS},
                           "max_tilt_deg": float(np.nanmax(tilt)) if tilt.size else 0.0})
         print(f"  t = {t:.2f} s  wall {time.perf_counter() - start:7.1f} s  on table "
-              f"{tilt_rows[-1]['on_table']}  tilted > 5 deg {tilt_rows[-1]['beyond_5_deg']}  "
+              f"{tilt_rows[-1]['on_table']}  re-inserted {tilt_rows[-1]['reinserted']}  "
+              f"tilted > 5 deg {tilt_rows[-1]['beyond_5_deg']}  "
               f"fallen > 60 deg {tilt_rows[-1]['beyond_60_deg']}", flush=True)
     wall = time.perf_counter() - start
     c = {k: np.asarray(v, dtype=object if k.startswith(("place", "partner")) else float)
@@ -134,6 +143,7 @@ def full_shapes(table: AccumulationTable, a: argparse.Namespace) -> dict[str, An
         pair_places[key] = pair_places.get(key, 0) + 1
     return {
         "wall_s": wall, "dt_s": float(sim.dt), "bodies_mean": bodies, "reached_s": t,
+        "refeed": refeed is not None, "reinsertions": int(len(sim.reinsertions()[0])),
         "onsets": int(c["time"].size),
         "by_partner": _by_partner(c["partner"], c["normal_speed"], seconds, bodies),
         "place_by_partner": by_place,
@@ -152,7 +162,7 @@ def spheres(table: AccumulationTable, a: argparse.Namespace) -> dict[str, Any]:
     names = [w["name"] for w in description.walls]
     start = time.perf_counter()
     sim = dem.from_scene(description, threads=a.threads, record_onsets=True)
-    sim.run_until(a.duration)
+    dem.run(sim, a.duration, refeed=description.refeed if a.refeed else None)
     wall = time.perf_counter() - start
     on = sim.onsets()
     keep = (np.asarray(on["time"]) >= a.warmup) & (np.asarray(on["normal_speed"]) >= a.min_speed)
@@ -179,16 +189,19 @@ def main() -> None:
     p.add_argument("--max-wall", type=float, default=None,
                    help="stop the full-shape run after this many wall seconds (its counts "
                         "then cover the warm-up's end to the time reached)")
+    p.add_argument("--refeed", action=argparse.BooleanOptionalAction, default=True,
+                   help="put removed cartridges (and spheres) back upstream (default) or let "
+                        "the table drain (--no-refeed)")
     p.add_argument("--out", default=str(OUT))
     a = p.parse_args()
     if not 0 <= a.warmup < a.duration:
         p.error("need 0 <= --warmup < --duration")
-    base = dict(wall_height=0.07, young_modulus=a.young_modulus)
+    base = dict(wall_height=0.07, young_modulus=a.young_modulus, refeed=a.refeed)
     doc: dict[str, Any] = {
         "command": "python benches/full_shape_table.py " + " ".join(
             f"--{k.replace('_', '-')} {v}" for k, v in vars(a).items() if k != "out"),
         "machine": platform.platform(), "cpus": os.cpu_count(),
-        "places": list(rigid.PLACES), "speed_edges_m_per_s": list(SPEED_EDGES),
+        "refeed": bool(a.refeed), "places": list(rigid.PLACES), "speed_edges_m_per_s": list(SPEED_EDGES),
         "tilt_classes_deg": list(TILTS)}
     doc["revolution"] = full_shapes(AccumulationTable(particle="revolution", **base), a)
     # the spheres over the same span as the cartridges reached

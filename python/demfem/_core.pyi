@@ -515,6 +515,22 @@ class RigidSimulation:
     def max_overlap(self) -> float: ...
     def contact_points(self) -> int: ...
     def remove_body(self, i: int) -> None: ...
+    def reinsert_body(
+        self,
+        i: int,
+        position: tuple[float, float, float],
+        orientation: tuple[float, float, float, float],
+        velocity: tuple[float, float, float],
+        *,
+        if_free: bool = False,
+    ) -> bool:
+        """Put removed body i back at position (m, centre of mass) with orientation (unit
+        quaternion (w, x, y, z) of its frame) and velocity (m/s), no spin. Raises naming the
+        field (i, position, orientation, velocity) for bad input or an occupied pose (one
+        where the exact shapes would touch an alive body or a wall); with if_free, an occupied
+        pose returns False and the body stays removed. True when put back."""
+    def reinsertions(self) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint32]]:
+        """Bodies put back: times (s) and indices."""
     def onsets(self) -> dict[str, npt.NDArray[Any]]:
         """Every contact onset: time (s), body, partner, partner_is_wall, normal_speed,
         tangential_speed (m/s), point (N, 3) the deepest contact point (world, m), normal

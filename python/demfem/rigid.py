@@ -40,6 +40,7 @@ __all__ = [
     "shape_dict",
     "upright",
     "from_scene",
+    "refeed_of",
     "run",
 ]
 
@@ -156,7 +157,8 @@ def from_scene(
     scene's particle mass at the scene's glass density, as the equivalent sphere does, so
     that spheres and full shapes carry the same mass. ``dt`` (s) defaults to the stable limit
     of the stiffest contact at ``expected_max_speed`` (m/s); a larger one is refused.
-    Bodies whose centre of mass crosses the scene's removal plane are removed. ``threads``:
+    Bodies whose centre of mass crosses the scene's removal plane are removed; a scene that
+    re-feeds them runs with ``run(sim, t, refeed=refeed_of(scene))``. ``threads``:
     the contact geometry of bodies of revolution on that many threads (bitwise the same
     result; tables of 64 bodies or more).
 
@@ -173,10 +175,6 @@ def from_scene(
         raise InvalidParameterError(
             f"invalid particle = {particle!r}: must be one of {FULL_SHAPES} "
             "(spheres run through demfem.dem.from_scene)")
-    if getattr(scene, "refeed", None):
-        raise InvalidParameterError(
-            "invalid refeed = True: the rigid engine removes cartridges through the outlet but "
-            "cannot re-insert them; run with refeed = False")
     c = (Cartridge.from_geometry((getattr(scene, "parameters", None) or {}).get("cartridge"))
          if cartridge is None else cartridge)
     pm = scene.materials[scene.particle_material]
@@ -212,6 +210,28 @@ def from_scene(
     )
 
 
+def refeed_of(scene: Any, *, cartridge: Optional[Cartridge] = None,
+              lift: float = 1e-6) -> Optional[dict[str, Any]]:
+    """The re-feed of ``scene`` (``scene.refeed``, sphere centres) for the rigid engine built
+    by :func:`from_scene` with the same ``cartridge`` and ``lift``: ``{"sites": (k, 3),
+    "sphere_sites": (k, 3), "velocity": (3,)}`` with the sites' (x, y), cartridges' centres of
+    mass and spheres' centres ``lift`` (m) above the belt, for ``run(sim, t, refeed=...)``
+    (removed bodies come back upright at the first free site). ``None`` without re-feed."""
+    refeed = getattr(scene, "refeed", None)
+    if not refeed:
+        return None
+    c = (Cartridge.from_geometry((getattr(scene, "parameters", None) or {}).get("cartridge"))
+         if cartridge is None else cartridge)
+    xy = np.asarray(refeed["sites"], float).reshape(-1, 3)[:, :2]
+    radius = float(np.asarray(scene.radii, float)[0])
+
+    def at(z: float) -> np.ndarray:
+        return np.column_stack([xy, np.full(len(xy), z + lift)])
+
+    return {"sites": at(float(c.center_of_mass[2])), "sphere_sites": at(radius),
+            "velocity": np.asarray(refeed.get("velocity", np.zeros(3)), float)}
+
+
 def run(
     sim: RigidSimulation,
     t_end: float,
@@ -219,7 +239,11 @@ def run(
     progress: Optional[Callable[[Progress], None]] = None,
     report_every: float = 1.0,
     chunk_steps: int = 2000,
+    refeed: Optional[dict[str, Any]] = None,
 ) -> int:
     """Advance ``sim`` to simulated time ``t_end`` (s), reporting progress as
-    :func:`demfem.dem.run`; Ctrl-C raises ``SimulationInterrupted`` at a step boundary."""
-    return _run(sim, t_end, progress=progress, report_every=report_every, chunk_steps=chunk_steps)
+    :func:`demfem.dem.run`; Ctrl-C raises ``SimulationInterrupted`` at a step boundary.
+    ``refeed`` (:func:`refeed_of`): after every chunk, removed bodies are put back upright at
+    the first free site."""
+    return _run(sim, t_end, progress=progress, report_every=report_every,
+                chunk_steps=chunk_steps, refeed=refeed)

@@ -42,6 +42,7 @@ __all__ = [
     "run",
     "from_scene",
     "refeed_removed",
+    "refeed_removed_bodies",
     "scene_walls",
     "check_state",
     "CONTACT_MODELS",
@@ -167,14 +168,16 @@ def run(
     ``SimulationInterrupted`` with the state consistent at a step boundary.
 
     ``refeed``: a scene's ``{"sites": (k, 3) m, "velocity": (3,) m/s}``; after every chunk,
-    removed particles are put back at the first free sites (:func:`refeed_removed`); spheres
-    (``DemSimulation``) only."""
-    if refeed is not None and not isinstance(sim, DemSimulation):
+    removed particles are put back at the first free sites (:func:`refeed_removed`). For a
+    ``RigidSimulation`` the sites are the centres of mass of the bodies put back, upright
+    (:func:`refeed_removed_bodies`; :func:`demfem.rigid.refeed_of` turns a scene's sphere
+    sites into them, with ``"sphere_sites"`` for the spheres of mixed tables)."""
+    if refeed is not None and not isinstance(sim, (DemSimulation, RigidSimulation)):
         from demfem.errors import InvalidParameterError
 
         raise InvalidParameterError(
             f"invalid refeed for a {type(sim).__name__}: re-feeding is implemented for "
-            "spheres (DemSimulation) only")
+            "DemSimulation and RigidSimulation")
     start_steps = sim.steps
     start_wall = _time.perf_counter()
     last_report = start_wall
@@ -184,7 +187,10 @@ def run(
         k = min(chunk_steps, total - done)
         sim.step(k, chunk=k)
         done += k
-        if refeed is not None and isinstance(sim, DemSimulation):
+        if refeed is not None and isinstance(sim, RigidSimulation):
+            refeed_removed_bodies(sim, refeed["sites"], refeed.get("velocity", (0.0, 0.0, 0.0)),
+                                  sphere_sites=refeed.get("sphere_sites"))
+        elif refeed is not None:
             refeed_removed(sim, refeed["sites"], refeed.get("velocity", (0.0, 0.0, 0.0)))
         now = _time.perf_counter()
         if progress is not None and (now - last_report >= report_every or done == total):
@@ -324,6 +330,50 @@ def refeed_removed(sim: DemSimulation, sites: Any, velocity: Vector = (0.0, 0.0,
                                       (vel[0], vel[1], vel[2]))
                 occupied = np.vstack([occupied, site])
                 occupied_r = np.append(occupied_r, radii[i])
+                placed += 1
+                break
+        else:
+            break  # every site is taken: the rest wait
+    return placed
+
+
+def refeed_removed_bodies(sim: RigidSimulation, sites: Any, velocity: Vector = (0.0, 0.0, 0.0),
+                          *, sphere_sites: Any = None,
+                          orientation: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0)
+                          ) -> int:
+    """Put removed bodies of a ``RigidSimulation`` back, lowest index first, each at the
+    first of ``sites`` ((k, 3) centres of mass, m) where the engine's exact contact test finds
+    it touching no alive body and no wall, with ``orientation`` (default upright: axis along
+    +z), ``velocity`` (m/s) and no spin. The equivalent spheres of mixed tables go to
+    ``sphere_sites`` (their centres) when given. A body for which no site is free waits, with
+    every body after it, for a later call. Returns how many were put back."""
+    import numpy as np
+
+    from demfem.errors import InvalidParameterError
+
+    def checked(name: str, value: Any) -> np.ndarray:
+        a = np.asarray(value, dtype=float)
+        if a.ndim > 2 or a.size % 3 or not np.all(np.isfinite(a)):
+            raise InvalidParameterError(
+                f"invalid {name} of shape {a.shape}: must be finite (k, 3) points, m")
+        return a.reshape(-1, 3)
+
+    dead = np.flatnonzero(~np.asarray(sim.alive(), dtype=bool))
+    if dead.size == 0:
+        return 0
+    cartridge_sites = checked("sites", sites)
+    spheres_at = cartridge_sites if sphere_sites is None else checked("sphere_sites", sphere_sites)
+    v = np.asarray(velocity, dtype=float)
+    if v.shape != (3,) or not np.all(np.isfinite(v)):
+        raise InvalidParameterError(f"invalid velocity = {velocity!r}: must be 3 finite m/s")
+    vel = (float(v[0]), float(v[1]), float(v[2]))
+    q = tuple(float(x) for x in orientation)
+    is_sphere = np.asarray(sim.is_sphere(), dtype=bool)
+    placed = 0
+    for i in dead:
+        for site in (spheres_at if is_sphere[i] else cartridge_sites):
+            at = (float(site[0]), float(site[1]), float(site[2]))
+            if sim.reinsert_body(int(i), at, q, vel, if_free=True):
                 placed += 1
                 break
         else:

@@ -496,6 +496,58 @@ impl RigidSimulation {
         Ok(())
     }
 
+    /// Put removed body `i` back at `position` (m, centre of mass) with `orientation` (unit
+    /// quaternion (w, x, y, z) of its frame, as the constructor's) and `velocity` (m/s), without
+    /// spin. Refused naming the field when `i` is out of range or alive, a value is not
+    /// finite, the quaternion is not unit, or the body would touch an alive body or a wall
+    /// there (the engine's exact contact test); with `if_free`, an occupied pose returns
+    /// False instead (the body stays removed). Returns True when put back.
+    #[pyo3(signature = (i, position, orientation, velocity, *, if_free=false))]
+    fn reinsert_body(
+        &mut self,
+        i: i64,
+        position: (f64, f64, f64),
+        orientation: (f64, f64, f64, f64),
+        velocity: (f64, f64, f64),
+        if_free: bool,
+    ) -> PyResult<bool> {
+        let n = self.scene.bodies.len();
+        let index = usize::try_from(i)
+            .ok()
+            .filter(|&k| k < n)
+            .ok_or_else(|| invalid("i", &i.to_string(), &format!("in [0, {n})")))?;
+        let user = Quaternion::new(orientation.0, orientation.1, orientation.2, orientation.3);
+        // the engine turns the principal frame; spheres have none
+        let body = if self.sphere.get(index).copied().unwrap_or(false) {
+            user
+        } else {
+            user * self.principal_frame.into_inner()
+        };
+        let x = Vector3::new(position.0, position.1, position.2);
+        let v = Vector3::new(velocity.0, velocity.1, velocity.2);
+        if if_free {
+            let obstacle = self
+                .scene
+                .reinsert_body_if_free(index, x, body, v)
+                .map_err(PyDemfemError::from)?;
+            Ok(obstacle.is_none())
+        } else {
+            self.scene
+                .reinsert_body(index, x, body, v)
+                .map_err(PyDemfemError::from)?;
+            Ok(true)
+        }
+    }
+
+    /// Bodies put back so far: (times (s), indices).
+    fn reinsertions<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<u32>>) {
+        let (t, i): (Vec<f64>, Vec<u32>) = self.scene.reinsertions().iter().copied().unzip();
+        (t.into_pyarray(py), i.into_pyarray(py))
+    }
+
     /// Every contact onset (first step of a new body–body or body–wall contact): time (s),
     /// body, partner, partner_is_wall, normal_speed (> 0 approaching), tangential_speed
     /// (m/s), and where it touched (see `demfem._core.pyi`): point, normal, point_body,

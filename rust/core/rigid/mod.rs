@@ -25,7 +25,7 @@ pub use body::{RigidBodies, RigidBodyInit};
 pub use collision::{BodyPose, ContactPoint, Plane, PolygonWall};
 pub use forces::{ContactMaterial, RigidContactLaw};
 pub use revolution::RevolutionShape;
-pub use scene::{RigidOnset, RigidScene, RigidSceneConfig, RigidWall};
+pub use scene::{Obstacle, RigidOnset, RigidScene, RigidSceneConfig, RigidWall};
 pub use shape::{
     BeadClump, BoundingCapsule, ExactShape, MassProperties, RevolutionProfile, RigidShape,
 };

@@ -22,7 +22,8 @@
 //! reports from one step to the next.
 //!
 //! The contacts of a step (detection against planes, walls and other bodies, forces with
-//! their friction history, onsets) are in the `contacts` submodule.
+//! their friction history, onsets) are in the `contacts` submodule; putting removed bodies
+//! back (re-feeding) in `reinsert`.
 
 use std::collections::{HashMap, HashSet};
 
@@ -39,8 +40,11 @@ use crate::error::{check_positive, DemfemError, Result};
 use crate::geometry::{MeshWall, WallMotion, WallShape};
 
 mod contacts;
+mod reinsert;
 mod revolution_geometry;
 mod revolution_pass;
+
+pub use reinsert::{Obstacle, UNIT_QUATERNION_TOLERANCE};
 
 use contacts::FrictionHistory;
 
@@ -247,6 +251,7 @@ pub struct RigidScene {
     removal_plane: Option<(Vector3<f64>, Vector3<f64>)>,
     alive: Vec<bool>,
     removals: Vec<(f64, u32)>,
+    reinsertions: Vec<(f64, u32)>,
     record_onsets: bool,
     onsets: Vec<RigidOnset>,
     touching: HashSet<u64>,
@@ -342,6 +347,7 @@ impl RigidScene {
             removal_plane,
             alive: Vec::new(),
             removals: Vec::new(),
+            reinsertions: Vec::new(),
             record_onsets: config.record_onsets,
             onsets: Vec::new(),
             touching: HashSet::new(),
@@ -607,7 +613,8 @@ impl RigidScene {
         }
     }
 
-    /// Take body `i` out of the scene: it stops, feels no force and touches nothing.
+    /// Take body `i` out of the scene: it stops, feels no force and touches nothing (until
+    /// [`RigidScene::reinsert_body`] puts it back).
     pub fn remove_body(&mut self, i: usize) {
         if i < self.alive.len() && self.alive[i] {
             self.alive[i] = false;

@@ -521,7 +521,7 @@ pub(super) fn capsules_overlap(
 
 /// Squared distance between segments [p0, p1] and [q0, q1], m² (Ericson, *Real-Time
 /// Collision Detection*, §5.1.9).
-fn segment_distance_squared(
+pub(super) fn segment_distance_squared(
     p0: &Vector3<f64>,
     p1: &Vector3<f64>,
     q0: &Vector3<f64>,

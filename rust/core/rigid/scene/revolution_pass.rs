@@ -63,6 +63,33 @@ impl RevolutionPass {
     pub(crate) fn rebuilds(&self) -> u64 {
         self.rebuilds
     }
+
+    /// Drop every trace of body `i` kept between evaluations — the Mindlin springs and the
+    /// touching flags of its body–boundary slots (`n_boundaries` per body) and of the listed
+    /// pairs it belongs to — and force a rebuild of the pair list at the next evaluation
+    /// (a body put back elsewhere: [`RigidScene::reinsert_body`]).
+    pub(crate) fn forget_body(&mut self, i: usize, n_boundaries: usize) {
+        for slot in i * n_boundaries..(i + 1) * n_boundaries {
+            if let Some(range) = self.wall_range.get_mut(slot) {
+                *range = (0, 0);
+            }
+            if let Some(touching) = self.wall_touching.get_mut(slot) {
+                *touching = false;
+            }
+        }
+        let body = i as u32;
+        for (k, &(a, b)) in self.pairs.iter().enumerate() {
+            if a == body || b == body {
+                if let Some(range) = self.pair_range.get_mut(k) {
+                    *range = (0, 0);
+                }
+                if let Some(touching) = self.pair_touching.get_mut(k) {
+                    *touching = false;
+                }
+            }
+        }
+        self.built_for = usize::MAX;
+    }
 }
 
 /// A body's bounding capsule inflated by half the skin, and the box around it: (lower x,
