@@ -416,7 +416,9 @@ def test_assess_uses_the_users_strength_file(tmp_path):
                  "--specimen-diameter", "0.020", "--surface", "outer",
                  "--out", str(strength)]) == 0
     small = AccumulationTable(width=0.1, length=0.1, tilted_wall_length=0.05, n_spheres=30)
-    kw = dict(duration=0.12, sample_interval=0.01, log=lambda _: None)
+    # every event at one place, so that each row's sigma and area are the whole of its P
+    # (with the default mix P is the expectation over places: test_assess_places.py)
+    kw = dict(duration=0.12, sample_interval=0.01, log=lambda _: None, place="body")
     base = assess(small, out=tmp_path / "a", **kw)
     mine = assess(small, out=tmp_path / "b", strength=strength, **kw)
     assert "strength.json" in mine["strength"]["source"] and mine["strength"]["measured"]
