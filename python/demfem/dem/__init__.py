@@ -190,7 +190,7 @@ def run(
         if refeed is not None and isinstance(sim, RigidSimulation):
             refeed_removed_bodies(sim, refeed["sites"], refeed.get("velocity", (0.0, 0.0, 0.0)),
                                   sphere_sites=refeed.get("sphere_sites"))
-        elif refeed is not None:
+        elif refeed is not None and isinstance(sim, DemSimulation):
             refeed_removed(sim, refeed["sites"], refeed.get("velocity", (0.0, 0.0, 0.0)))
         now = _time.perf_counter()
         if progress is not None and (now - last_report >= report_every or done == total):
@@ -367,7 +367,8 @@ def refeed_removed_bodies(sim: RigidSimulation, sites: Any, velocity: Vector = (
     if v.shape != (3,) or not np.all(np.isfinite(v)):
         raise InvalidParameterError(f"invalid velocity = {velocity!r}: must be 3 finite m/s")
     vel = (float(v[0]), float(v[1]), float(v[2]))
-    q = tuple(float(x) for x in orientation)
+    q = (float(orientation[0]), float(orientation[1]), float(orientation[2]),
+         float(orientation[3]))
     is_sphere = np.asarray(sim.is_sphere(), dtype=bool)
     placed = 0
     for i in dead:
