@@ -319,7 +319,9 @@ fn foot_past_a_plate_edge(threads: usize, speed: f64, steps: u64) -> (f64, f64, 
         ..Default::default()
     };
     let mut scene = RigidScene::new(config).unwrap();
-    let id = scene.add_shape(RigidShape::Revolution(shape), mass).unwrap();
+    let id = scene
+        .add_shape(RigidShape::Revolution(shape), mass)
+        .unwrap();
     scene
         .add_body(id, position, q, Vector3::zeros(), Vector3::zeros())
         .unwrap();
