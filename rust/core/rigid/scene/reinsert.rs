@@ -312,20 +312,39 @@ impl RigidScene {
     }
 
     /// True when the axis segments of bodies `i` and `j` (their bounding capsules' cores,
-    /// inside the bodies) meet, to [`AXES_MEET`]: the bodies then surely overlap. The contact
-    /// tests are built for the micrometre overlaps of a step and may find nothing between
-    /// bodies that overlap through and through — two cartridges at one site, whose normal is
-    /// undefined —; this catches those.
+    /// inside the bodies) come closer than [`AXES_MEET`] plus the radii the bodies are solid
+    /// to around them: the bodies then surely overlap. A body of revolution holds the
+    /// capsule of its smallest outline radius ρ about its core shortened by ρ at each end
+    /// (the cartridge's neck: 3 mm); other shapes count their core alone. The contact tests
+    /// are built for the micrometre overlaps of a step and may find nothing between bodies
+    /// that overlap through and through — two cartridges at one site, whose normal is
+    /// undefined, or a body re-fed at its site millimetres from one that has not left it
+    /// yet —; this catches those.
     fn axes_cross(&self, i: usize, j: usize) -> bool {
         let core = |k: usize| {
-            let capsule = self.shapes[self.body_shape[k]].0.bounding_capsule();
+            let shape = &self.shapes[self.body_shape[k]].0;
+            let capsule = shape.bounding_capsule();
+            let solid = match shape {
+                // the outline runs from (z_bottom, 0) up the outside to (z_top, 0)
+                RigidShape::Revolution(r) => r.outline[1..r.outline.len().saturating_sub(1)]
+                    .iter()
+                    .map(|p| p.1)
+                    .fold(f64::INFINITY, f64::min)
+                    .min(0.5 * (capsule.z_max - capsule.z_min))
+                    .max(0.0),
+                _ => 0.0,
+            };
             let axis = self.bodies.orientation[k] * Vector3::z();
             let x = self.bodies.position[k];
-            (x + axis * capsule.z_min, x + axis * capsule.z_max)
+            (
+                x + axis * (capsule.z_min + solid),
+                x + axis * (capsule.z_max - solid),
+                solid,
+            )
         };
-        let (a0, a1) = core(i);
-        let (b0, b1) = core(j);
-        let reach = AXES_MEET;
+        let (a0, a1, ra) = core(i);
+        let (b0, b1, rb) = core(j);
+        let reach = AXES_MEET + ra + rb;
         super::contacts::segment_distance_squared(&a0, &a1, &b0, &b1) < reach * reach
     }
 }
