@@ -594,6 +594,18 @@ impl RigidScene {
         Ok(())
     }
 
+    /// Each wall's displacement and velocity at `time` (s): (offset m, velocity m/s), in the
+    /// order of `walls` (the boundaries after the planes).
+    fn wall_offsets(&self, time: f64) -> Vec<(Vector3<f64>, Vector3<f64>)> {
+        self.walls
+            .iter()
+            .map(|w| {
+                let (x, v) = w.motion.offset_and_velocity(time);
+                (Vector3::new(x.x, x.y, x.z), Vector3::new(v.x, v.y, v.z))
+            })
+            .collect()
+    }
+
     fn pose(&self, i: usize) -> BodyPose {
         BodyPose {
             position: self.bodies.position[i],

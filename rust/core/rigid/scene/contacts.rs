@@ -166,14 +166,7 @@ impl RigidScene {
         let n_planes = self.planes.len();
         let n_boundaries = n_planes + self.walls.len();
         // boundaries at this time: planes as given, walls displaced by their motion
-        let offsets: Vec<(Vector3<f64>, Vector3<f64>)> = self
-            .walls
-            .iter()
-            .map(|w| {
-                let (x, v) = w.motion.offset_and_velocity(time);
-                (Vector3::new(x.x, x.y, x.z), Vector3::new(v.x, v.y, v.z))
-            })
-            .collect();
+        let offsets = self.wall_offsets(time);
         for i in 0..self.bodies.len() {
             if !self.alive[i] {
                 continue;

@@ -187,14 +187,7 @@ impl RigidScene {
         let n = self.bodies.len();
         let n_planes = self.planes.len();
         let n_boundaries = n_planes + self.walls.len();
-        let offsets: Vec<(Vector3<f64>, Vector3<f64>)> = self
-            .walls
-            .iter()
-            .map(|w| {
-                let (x, v) = w.motion.offset_and_velocity(self.time);
-                (Vector3::new(x.x, x.y, x.z), Vector3::new(v.x, v.y, v.z))
-            })
-            .collect();
+        let offsets = self.wall_offsets(self.time);
         let shape_i = &self.shapes[self.body_shape[i]].0;
         let pose_i = self.pose(i);
         let mut frames_now = Vec::new();

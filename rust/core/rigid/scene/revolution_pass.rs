@@ -245,14 +245,7 @@ impl RigidScene {
         let n = self.bodies.len();
         let dt = self.time_step;
         let n_boundaries = self.planes.len() + self.walls.len();
-        let offsets: Vec<(V3, V3)> = self
-            .walls
-            .iter()
-            .map(|w| {
-                let (x, v) = w.motion.offset_and_velocity(time);
-                (Vector3::new(x.x, x.y, x.z), Vector3::new(v.x, v.y, v.z))
-            })
-            .collect();
+        let offsets = self.wall_offsets(time);
         frames(&self.bodies.orientation, &mut pass.frames);
         // the geometry, in blocks of bodies and of pairs (on the scene's threads)
         let blocks = match &self.pool {
