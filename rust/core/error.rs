@@ -94,6 +94,19 @@ pub fn check_positive(field: &str, value: f64) -> Result<f64> {
     }
 }
 
+/// Check that every component of a vector (or any list of values) named `field` is finite.
+pub fn check_finite(field: &str, values: &[f64]) -> Result<()> {
+    if values.iter().all(|x| x.is_finite()) {
+        Ok(())
+    } else {
+        Err(DemfemError::InvalidParameter {
+            field: field.into(),
+            value: format!("{values:?}"),
+            allowed: "finite components".into(),
+        })
+    }
+}
+
 /// Check `value >= 0` and finite.
 pub fn check_non_negative(field: &str, value: f64) -> Result<f64> {
     if value.is_finite() && value >= 0.0 {

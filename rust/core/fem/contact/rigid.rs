@@ -5,7 +5,7 @@
 //! along the surface's normal, k_node = Σ k_f/3 over the node's faces, met half the node's
 //! thickness early on a shell, with the stick spring against the surface's material.
 
-use crate::error::{check_non_negative, check_positive, DemfemError, Result};
+use crate::error::{check_finite, check_non_negative, check_positive, DemfemError, Result};
 
 use super::friction::friction_update;
 use super::hits::Hit;
@@ -68,26 +68,14 @@ fn unit(field: &str, v: [f64; 3]) -> Result<[f64; 3]> {
     Ok(scale(v, 1.0 / n))
 }
 
-fn finite(field: &str, v: [f64; 3]) -> Result<()> {
-    if v.iter().all(|x| x.is_finite()) {
-        Ok(())
-    } else {
-        Err(DemfemError::InvalidParameter {
-            field: field.into(),
-            value: format!("{v:?}"),
-            allowed: "finite".into(),
-        })
-    }
-}
-
 impl RigidSurface {
     /// Check the values and normalise the directions.
     pub fn validated(mut self) -> Result<Self> {
         check_non_negative("friction", self.friction)?;
-        finite("surface_velocity", self.surface_velocity)?;
+        check_finite("surface_velocity", &self.surface_velocity)?;
         self.shape = match self.shape {
             RigidShape::Plane { point, normal } => {
-                finite("plane point", point)?;
+                check_finite("plane point", &point)?;
                 RigidShape::Plane {
                     point,
                     normal: unit("plane normal", normal)?,
@@ -98,8 +86,8 @@ impl RigidSurface {
                 radius,
                 velocity,
             } => {
-                finite("sphere center", center)?;
-                finite("sphere velocity", velocity)?;
+                check_finite("sphere center", &center)?;
+                check_finite("sphere velocity", &velocity)?;
                 check_positive("sphere radius", radius)?;
                 RigidShape::Sphere {
                     center,
@@ -112,7 +100,7 @@ impl RigidSurface {
                 axis,
                 radius,
             } => {
-                finite("cylinder point", point)?;
+                check_finite("cylinder point", &point)?;
                 check_positive("cylinder radius", radius)?;
                 RigidShape::Cylinder {
                     point,

@@ -19,7 +19,7 @@ use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
 use super::revolution_geometry::{frames, Block};
 use super::{PreparedShape, RigidScene};
-use crate::error::{DemfemError, Result};
+use crate::error::{check_finite, DemfemError, Result};
 use crate::rigid::collision::{
     clump_exact_contacts, exact_exact_contacts, exact_plane_contacts, exact_polygon_contacts,
     ContactPoint, ExactContactCache, Plane,
@@ -47,18 +47,6 @@ impl std::fmt::Display for Obstacle {
             Obstacle::Body(j) => write!(f, "body {j}"),
             Obstacle::Wall(p) => write!(f, "wall {p}"),
         }
-    }
-}
-
-fn finite(field: &str, v: &[f64]) -> Result<()> {
-    if v.iter().all(|x| x.is_finite()) {
-        Ok(())
-    } else {
-        Err(DemfemError::InvalidParameter {
-            field: field.into(),
-            value: format!("{v:?}"),
-            allowed: "finite components".into(),
-        })
     }
 }
 
@@ -113,9 +101,9 @@ impl RigidScene {
                 allowed: "a removed body".into(),
             });
         }
-        finite("position", position.as_slice())?;
-        finite("velocity", velocity.as_slice())?;
-        finite("orientation", orientation.coords.as_slice())?;
+        check_finite("position", position.as_slice())?;
+        check_finite("velocity", velocity.as_slice())?;
+        check_finite("orientation", orientation.coords.as_slice())?;
         let norm = orientation.norm();
         if (norm - 1.0).abs() > UNIT_QUATERNION_TOLERANCE {
             return Err(DemfemError::InvalidParameter {
