@@ -96,13 +96,13 @@ def _write_places_vtk(out: Path, run, cartridge: Any, events: np.ndarray,
         "sigma_inner_Pa": np.asarray(stress["sigma_inner_Pa_by_place"], float)[k, pl]})
 
 
-def _place_summary(events: np.ndarray, p: dict[str, np.ndarray],
+def _place_summary(p: dict[str, np.ndarray], parts: dict[str, np.ndarray],
                    inside: np.ndarray) -> dict[str, Any]:
     """Shares of the window's hazard by place on the cartridge (``place_share``) and by
-    place and surface (``place_surface_share``), when the events have places."""
+    place and surface (``place_surface_share``) from the events' hazard ``parts``
+    (:func:`hazard_components`), when the events have places."""
     if "place_weight" not in p:
         return {}
-    parts = hazard_components(events, p)
     tot = sum(float(v[inside].sum()) for v in parts.values())
     if tot <= 0:
         return {"place_share": None, "place_surface_share": None}
@@ -240,22 +240,28 @@ def _basis(model, scg, ev_summary: dict[str, Any], e_stress: float, table,
     return lines
 
 
-def _interval(events: np.ndarray, p: dict[str, np.ndarray], inside: np.ndarray,
-              window: tuple[float, float], period: Optional[float], wall_names: list[str],
-              pr: dict[str, Any]) -> dict[str, Any]:
+def _interval(events: np.ndarray, p: dict[str, np.ndarray], parts: dict[str, np.ndarray],
+              inside: np.ndarray, window: tuple[float, float], period: Optional[float],
+              wall_names: list[str], pr: dict[str, Any]) -> dict[str, Any]:
     """The 95 % interval of the hourly number over whole gate periods (block totals,
     Student-t on the log scale: :func:`demfem.risk.interval.hourly_interval_from_events`),
-    with its splits by place on the table, by partner and by surface (mechanism), carried
-    onto the headline figures as relative bounds. Without two whole periods: no interval."""
+    with its splits by place on the table, by partner, by surface (mechanism) and, with
+    places, by place on the cartridge and by place and surface (the events' hazard
+    ``parts``, :func:`hazard_components`), carried onto the headline figures as relative
+    bounds. Without two whole periods: no interval."""
     from demfem.risk.interval import hourly_interval_from_events
 
     block = float(period) if period else 1.0
     ev = events[inside]
-    comps = hazard_components(ev, {k: v[inside] for k, v in p.items()}, by_place=False)
+    parts = {k: v[inside] for k, v in parts.items()}
+    places_on = "place_weight" in p
+    comps: dict[str, np.ndarray] = parts
+    if places_on:  # the surfaces summed over the places
+        comps = {s: np.sum([v for k, v in parts.items() if k.endswith(" " + s)], axis=0)
+                 for s in ("outer", "inner")}
     ci = hourly_interval_from_events(ev, p["p_event"][inside], window, block,
                                      wall_names=wall_names, components=comps)
-    if "place_weight" in p:
-        parts = hazard_components(ev, {k: v[inside] for k, v in p.items()})
+    if places_on:
         places = {pl: parts[f"{pl} outer"] + parts[f"{pl} inner"]
                   for pl in {k.split()[0]: None for k in parts}}
         by_place = hourly_interval_from_events(ev, p["p_event"][inside], window, block,
@@ -408,7 +414,8 @@ def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[st
                for k, name in enumerate(wall_names)
                if h_all > 0 and np.any(inside & (events["wall"] == k))}
     w = pr["window_s"]
-    ci = _interval(events, p, inside, window, period, wall_names, pr)
+    parts = hazard_components(events, p)  # by surface, and by place when there are places
+    ci = _interval(events, p, parts, inside, window, period, wall_names, pr)
     periods = _period_check(events, hazard, inside, window, period, wall_names, stress)
 
     def mx(a: np.ndarray) -> Optional[float]:
@@ -442,7 +449,7 @@ def risk_document(out: Path, run, table, events: np.ndarray, ev_summary: dict[st
             float(table.young_modulus), e_stress, rel_tol=1e-12),
         "max_sigma_inner_Pa": mx(stress["sigma_inner_Pa"][inside]),
         "max_sigma_outer_Pa": mx(stress["sigma_outer_Pa"][inside]),
-        **_place_summary(events, p, inside),
+        **_place_summary(p, parts, inside),
     }
     warnings = []
     if table.young_modulus < PAPER_GLASS.E:
